@@ -1,0 +1,2 @@
+//! grit-erosion: the science around the SPH engine (seed paper section 4).
+#![warn(missing_docs)]

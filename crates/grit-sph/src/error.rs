@@ -1,0 +1,35 @@
+//! Errors: bad input names its field and rule; a failed simulation names step, particle and quantity.
+
+use thiserror::Error;
+
+/// A rejected input: `field` is the dotted path of the offending value, `rule` what it broke.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{field}: {rule}")]
+pub struct InputError {
+    /// Dotted path of the field, e.g. `material.poisson_ratio`.
+    pub field: String,
+    /// The rule that the value broke.
+    pub rule: String,
+}
+
+impl InputError {
+    /// Builds an error for `field` breaking `rule`.
+    pub fn new(field: impl Into<String>, rule: impl Into<String>) -> Self {
+        InputError {
+            field: field.into(),
+            rule: rule.into(),
+        }
+    }
+}
+
+/// A simulation that went unstable (DESIGN.md "never fails silently").
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("simulation failed at step {step} (t = {time_s:.6e} s): {what}")]
+pub struct SimError {
+    /// Step number at which the check fired.
+    pub step: u64,
+    /// Simulated time at that step (s).
+    pub time_s: f64,
+    /// What went wrong, naming the particle or body and the quantity.
+    pub what: String,
+}
