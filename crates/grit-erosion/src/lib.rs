@@ -1,2 +1,18 @@
-//! grit-erosion: the science around the SPH engine (seed paper section 4).
+//! grit-erosion: the science around the SPH engine (seed paper section 4): grain shapes
+//! and their shape factors, aggregation of per-impact mass losses into erosion, and the
+//! Oka and shape-modified Oka erosion models fitted to simulated erosion.
 #![warn(missing_docs)]
+
+pub mod aggregate;
+pub mod fits;
+pub mod shapes;
+
+pub use aggregate::{
+    aggregate_campaign, aggregate_cell, AggregateError, CampaignResults, CellInput, CellResult,
+    Impact, SampleInput, SLOPE_WINDOW,
+};
+pub use fits::{
+    fit_modified_oka, fit_oka, FitError, ModifiedOkaModel, OkaModel, ShapeExponents,
+    ShapeReference, AISI304_HV_GPA,
+};
+pub use shapes::{Shape, ShapeError, ShapeInfo};
