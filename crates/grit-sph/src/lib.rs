@@ -9,3 +9,22 @@ pub mod material;
 
 pub use error::{InputError, SimError};
 pub use material::{JohnsonCook, JohnsonCookDamage, Material};
+pub mod body;
+pub mod contact;
+pub mod geometry;
+pub mod kernel;
+pub mod math;
+pub mod neighbours;
+pub mod particles;
+pub mod physics;
+pub mod timers;
+pub mod world;
+
+pub use body::{Body, BodyKind, ExternalForce, Motion, Rigid};
+pub use contact::{ContactModel, ContactParams};
+pub use geometry::Polygon;
+pub use kernel::{Kernel, KernelKind};
+pub use math::{Matrix, Vector};
+pub use timers::{Stage, Timers};
+pub use world::{Energy, NumericalWork, Settings, World};
+pub mod verification;

@@ -1,0 +1,361 @@
+//! Polygons and how bodies are filled with particles: a square lattice for deformable bodies,
+//! boundary-conforming layers for rigid bodies, so a grain's contact surface is as smooth as
+//! the polygon it stands for (the extrapolated-normal contact of seed section 3.1 needs that).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::InputError;
+use crate::math::{cross, Vector};
+
+/// A simple polygon, vertices counter-clockwise (m).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Polygon {
+    vertices: Vec<Vector>,
+}
+
+impl Polygon {
+    /// Validates and builds a polygon; `field` names the input for errors.
+    ///
+    /// Rejects fewer than 3 vertices, non-finite coordinates, zero area and self-intersection;
+    /// clockwise input is reversed so every polygon is counter-clockwise.
+    pub fn new(vertices: &[[f64; 2]], field: &str) -> Result<Self, InputError> {
+        if vertices.len() < 3 {
+            return Err(InputError::new(
+                field,
+                format!(
+                    "a polygon needs at least 3 vertices, got {}",
+                    vertices.len()
+                ),
+            ));
+        }
+        if let Some(k) = vertices
+            .iter()
+            .position(|v| !(v[0].is_finite() && v[1].is_finite()))
+        {
+            return Err(InputError::new(
+                format!("{field}[{k}]"),
+                "vertex coordinates must be finite",
+            ));
+        }
+        let mut v: Vec<Vector> = vertices.iter().map(|p| Vector::new(p[0], p[1])).collect();
+        let n = v.len();
+        for i in 0..n {
+            if (v[i] - v[(i + 1) % n]).norm() == 0.0 {
+                return Err(InputError::new(
+                    format!("{field}[{}]", (i + 1) % n),
+                    "repeats the vertex before it",
+                ));
+            }
+        }
+        // Any two non-adjacent edges that touch make the polygon non-simple.
+        for i in 0..n {
+            for j in i + 1..n {
+                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+                if adjacent {
+                    continue;
+                }
+                if segments_intersect(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]) {
+                    return Err(InputError::new(
+                        field,
+                        format!("polygon is self-intersecting: edge {i} crosses edge {j}"),
+                    ));
+                }
+            }
+        }
+        let a = signed_area(&v);
+        if a.abs() <= f64::EPSILON * bbox_diag2(&v) {
+            return Err(InputError::new(field, "polygon has zero area"));
+        }
+        if a < 0.0 {
+            v.reverse();
+        }
+        Ok(Polygon { vertices: v })
+    }
+
+    /// Regular n-gon of circumradius `r`, first vertex at angle `phase` (rad).
+    pub fn regular(n: usize, r: f64, phase: f64) -> Self {
+        let vertices = (0..n)
+            .map(|k| {
+                let t = phase + 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+                Vector::new(r * t.cos(), r * t.sin())
+            })
+            .collect();
+        Polygon { vertices }
+    }
+
+    /// Axis-aligned rectangle [x0, x1] × [y0, y1].
+    pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Self {
+        Polygon {
+            vertices: vec![
+                Vector::new(x0, y0),
+                Vector::new(x1, y0),
+                Vector::new(x1, y1),
+                Vector::new(x0, y1),
+            ],
+        }
+    }
+
+    /// Vertices, counter-clockwise.
+    pub fn vertices(&self) -> &[Vector] {
+        &self.vertices
+    }
+
+    /// Area (m²).
+    pub fn area(&self) -> f64 {
+        signed_area(&self.vertices)
+    }
+
+    /// Centroid (m).
+    pub fn centroid(&self) -> Vector {
+        let v = &self.vertices;
+        let n = v.len();
+        let mut c = Vector::zeros();
+        for i in 0..n {
+            let (a, b) = (v[i], v[(i + 1) % n]);
+            c += (a + b) * cross(a, b);
+        }
+        c / (6.0 * self.area())
+    }
+
+    /// Polar second moment of area about the centroid (m⁴); times density gives the inertia.
+    pub fn polar_moment(&self) -> f64 {
+        let c = self.centroid();
+        let v: Vec<Vector> = self.vertices.iter().map(|p| p - c).collect();
+        let n = v.len();
+        let mut j = 0.0;
+        for i in 0..n {
+            let (a, b) = (v[i], v[(i + 1) % n]);
+            j += cross(a, b) * (a.dot(&a) + a.dot(&b) + b.dot(&b));
+        }
+        j / 12.0
+    }
+
+    /// The polygon moved by `d`.
+    pub fn translated(&self, d: Vector) -> Self {
+        Polygon {
+            vertices: self.vertices.iter().map(|p| p + d).collect(),
+        }
+    }
+
+    /// The polygon rotated by `theta` (rad) about `centre`.
+    pub fn rotated(&self, theta: f64, centre: Vector) -> Self {
+        Polygon {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|p| centre + crate::math::rotate(p - centre, theta))
+                .collect(),
+        }
+    }
+
+    /// Even–odd point-in-polygon test.
+    pub fn contains(&self, p: Vector) -> bool {
+        let v = &self.vertices;
+        let n = v.len();
+        let mut inside = false;
+        let mut j = n - 1;
+        for i in 0..n {
+            let (a, b) = (v[i], v[j]);
+            if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
+                inside = !inside;
+            }
+            j = i;
+        }
+        inside
+    }
+
+    /// Distance from `p` to the nearest edge (m).
+    pub fn distance_to_boundary(&self, p: Vector) -> f64 {
+        let v = &self.vertices;
+        let n = v.len();
+        (0..n)
+            .map(|i| point_segment_distance(p, v[i], v[(i + 1) % n]))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Square lattice of spacing `dx` (cell-centred on `origin`) clipped to the polygon: the
+    /// particle layout of a deformable body. Each point stands for dx² of area.
+    pub fn fill_lattice(&self, dx: f64, origin: Vector) -> Vec<Vector> {
+        let (lo, hi) = self.bbox();
+        let i0 = ((lo.x - origin.x) / dx).floor() as i64 - 1;
+        let i1 = ((hi.x - origin.x) / dx).ceil() as i64 + 1;
+        let j0 = ((lo.y - origin.y) / dx).floor() as i64 - 1;
+        let j1 = ((hi.y - origin.y) / dx).ceil() as i64 + 1;
+        let mut out = Vec::new();
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let p = origin + Vector::new((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx);
+                if self.contains(p) {
+                    out.push(p);
+                }
+            }
+        }
+        out
+    }
+
+    /// Rigid-body fill: an outer layer of particles spaced about `dx` along the polygon inset by
+    /// dx/2, so the boundary layer is as straight as the edges, then interior lattice points at
+    /// least `dx` inside. Returns (points, is_boundary).
+    pub fn fill_layered(&self, dx: f64) -> (Vec<Vector>, Vec<bool>) {
+        let inset = self.inset_vertices(0.5 * dx);
+        let n = inset.len();
+        let mut pts = Vec::new();
+        let mut boundary = Vec::new();
+        for i in 0..n {
+            let (a, b) = (inset[i], inset[(i + 1) % n]);
+            let len = (b - a).norm();
+            let m = (len / dx).round().max(1.0) as usize;
+            // Vertex a belongs to this edge, b to the next one, so corners appear once.
+            for k in 0..m {
+                pts.push(a + (b - a) * (k as f64 / m as f64));
+                boundary.push(true);
+            }
+        }
+        let c = self.centroid();
+        for p in self.fill_lattice(dx, c - Vector::new(0.5 * dx, 0.5 * dx)) {
+            if self.distance_to_boundary(p) >= 1.0 * dx - 1e-12 * dx {
+                pts.push(p);
+                boundary.push(false);
+            }
+        }
+        (pts, boundary)
+    }
+
+    /// Vertices of the polygon offset inwards by `d` (mitred corners); valid for convex corners
+    /// and gentle concave ones, which is what grains are.
+    fn inset_vertices(&self, d: f64) -> Vec<Vector> {
+        let v = &self.vertices;
+        let n = v.len();
+        (0..n)
+            .map(|i| {
+                let prev = v[(i + n - 1) % n];
+                let cur = v[i];
+                let next = v[(i + 1) % n];
+                let e1 = (cur - prev).normalize();
+                let e2 = (next - cur).normalize();
+                // Inward normals of a counter-clockwise polygon point left of each edge.
+                let n1 = Vector::new(-e1.y, e1.x);
+                let n2 = Vector::new(-e2.y, e2.x);
+                let bis = n1 + n2;
+                let cos_half = (bis.norm() * 0.5).max(1e-6);
+                cur + bis.normalize() * (d / cos_half)
+            })
+            .collect()
+    }
+
+    /// Bounding box (min, max).
+    pub fn bbox(&self) -> (Vector, Vector) {
+        let mut lo = Vector::new(f64::INFINITY, f64::INFINITY);
+        let mut hi = -lo;
+        for p in &self.vertices {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        (lo, hi)
+    }
+}
+
+fn signed_area(v: &[Vector]) -> f64 {
+    let n = v.len();
+    (0..n).map(|i| cross(v[i], v[(i + 1) % n])).sum::<f64>() * 0.5
+}
+
+fn bbox_diag2(v: &[Vector]) -> f64 {
+    let mut lo = Vector::new(f64::INFINITY, f64::INFINITY);
+    let mut hi = -lo;
+    for p in v {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (hi - lo).norm_squared()
+}
+
+fn point_segment_distance(p: Vector, a: Vector, b: Vector) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+    (p - (a + ab * t)).norm()
+}
+
+fn orient(a: Vector, b: Vector, c: Vector) -> f64 {
+    cross(b - a, c - a)
+}
+
+fn segments_intersect(p1: Vector, p2: Vector, q1: Vector, q2: Vector) -> bool {
+    let d1 = orient(q1, q2, p1);
+    let d2 = orient(q1, q2, p2);
+    let d3 = orient(p1, p2, q1);
+    let d4 = orient(p1, p2, q2);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    let on = |a: Vector, b: Vector, c: Vector, d: f64| {
+        d == 0.0
+            && c.x >= a.x.min(b.x)
+            && c.x <= a.x.max(b.x)
+            && c.y >= a.y.min(b.y)
+            && c.y <= a.y.max(b.y)
+    };
+    on(q1, q2, p1, d1) || on(q1, q2, p2, d2) || on(p1, p2, q1, d3) || on(p1, p2, q2, d4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn self_intersecting_polygon_is_rejected_naming_the_field() {
+        let bow = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]];
+        let e = Polygon::new(&bow, "grain.vertices_m").unwrap_err();
+        assert_eq!(e.field, "grain.vertices_m");
+        assert!(e.rule.contains("self-intersecting"), "{e}");
+    }
+
+    #[test]
+    fn degenerate_polygons_are_rejected() {
+        assert!(Polygon::new(&[[0.0, 0.0], [1.0, 0.0]], "p").is_err());
+        assert!(Polygon::new(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], "p").is_err());
+        assert!(Polygon::new(&[[0.0, 0.0], [f64::NAN, 0.0], [0.0, 1.0]], "p").is_err());
+    }
+
+    #[test]
+    fn clockwise_input_is_made_counter_clockwise() {
+        let p = Polygon::new(&[[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]], "p").unwrap();
+        assert!((p.area() - 1.0).abs() < 1e-15);
+        assert!((p.centroid() - Vector::new(0.5, 0.5)).norm() < 1e-15);
+        // Square of side 1: J = 1/6.
+        assert!((p.polar_moment() - 1.0 / 6.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn lattice_fill_matches_area() {
+        let p = Polygon::regular(6, 1.0, 0.0);
+        let dx = 0.01;
+        let pts = p.fill_lattice(dx, Vector::zeros());
+        let a = pts.len() as f64 * dx * dx;
+        assert!(
+            (a - p.area()).abs() / p.area() < 0.01,
+            "{a} vs {}",
+            p.area()
+        );
+    }
+
+    #[test]
+    fn layered_fill_puts_boundary_particles_half_a_spacing_inside() {
+        let p = Polygon::regular(6, 1.0, 0.1);
+        let dx = 0.05;
+        let (pts, b) = p.fill_layered(dx);
+        for (q, &isb) in pts.iter().zip(&b) {
+            let d = p.distance_to_boundary(*q);
+            if isb {
+                assert!(
+                    (d - 0.5 * dx).abs() < 1e-9 || d < 0.5 * dx + 1e-9,
+                    "boundary particle at depth {d}"
+                );
+            } else {
+                assert!(d >= dx - 1e-9);
+            }
+        }
+    }
+}

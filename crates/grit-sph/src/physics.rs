@@ -1,0 +1,192 @@
+//! Constitutive pieces, per particle: Johnson–Cook yield (eq. 18), the radial return of J2
+//! plasticity, adiabatic heating, and Johnson–Cook fracture strain (eqs. 19–20).
+
+use crate::material::{JohnsonCook, JohnsonCookDamage};
+use crate::math::Matrix;
+use crate::particles::von_mises;
+
+/// Homologous temperature T* = (T − Tref)/(Tmelt − Tref), clamped to [0, 1].
+#[inline]
+pub fn homologous_temperature(jc: &JohnsonCook, t: f64) -> f64 {
+    ((t - jc.t_ref_k) / (jc.t_melt_k - jc.t_ref_k)).clamp(0.0, 1.0)
+}
+
+/// Johnson–Cook yield stress (eq. 18) and its derivatives with respect to plastic strain and
+/// plastic strain rate. The rate term is (1 + C ln(ε̇/ε̇0)), held at 1 below ε̇0 so the
+/// logarithm never softens the material (NOTES.md).
+#[inline]
+pub fn jc_yield(jc: &JohnsonCook, eps_p: f64, rate: f64, t: f64) -> (f64, f64, f64) {
+    let hard = jc.a_pa + jc.b_pa * eps_p.max(0.0).powf(jc.n);
+    let dhard = if eps_p > 0.0 {
+        jc.b_pa * jc.n * eps_p.powf(jc.n - 1.0)
+    } else {
+        0.0
+    };
+    let (rate_term, drate) = if rate > jc.ref_strain_rate_s {
+        (1.0 + jc.c * (rate / jc.ref_strain_rate_s).ln(), jc.c / rate)
+    } else {
+        (1.0, 0.0)
+    };
+    let th = 1.0 - homologous_temperature(jc, t).powf(jc.m);
+    (
+        hard * rate_term * th,
+        dhard * rate_term * th,
+        hard * drate * th,
+    )
+}
+
+/// Result of the return mapping for one particle and one step.
+#[derive(Debug, Clone, Copy)]
+pub struct Plastic {
+    /// Corrected in-plane deviatoric stress.
+    pub sdev: Matrix,
+    /// Plastic strain increment Δε_p.
+    pub d_eps: f64,
+    /// Yield stress at the end of the step (Pa).
+    pub sigma_y: f64,
+}
+
+/// J2 radial return (Wilkins; Simo & Hughes 1998, box 3.1): the trial deviator is scaled back to
+/// the Johnson–Cook yield surface, solving σ_eq* − 3GΔε = σ_y(ε_p + Δε, Δε/Δt, T) for Δε by
+/// safeguarded Newton iteration.
+///
+/// For J2 with isotropic hardening the closest-point projection is radial, so this is the
+/// converged limit of the seed's cutting-plane iterations, reached with one scalar solve.
+pub fn radial_return(
+    s_trial: Matrix,
+    shear: f64,
+    jc: &JohnsonCook,
+    eps_p: f64,
+    dt: f64,
+    t: f64,
+) -> Plastic {
+    let seq = von_mises(&s_trial);
+    let (sy0, _, _) = jc_yield(jc, eps_p, 0.0, t);
+    if seq <= sy0 {
+        return Plastic {
+            sdev: s_trial,
+            d_eps: 0.0,
+            sigma_y: sy0,
+        };
+    }
+    // f(Δε) = seq − 3GΔε − σy(Δε) is decreasing; bracket the root in [0, seq/3G].
+    let f = |de: f64| {
+        let (sy, dsde, dsdr) = jc_yield(jc, eps_p + de, de / dt, t);
+        (
+            seq - 3.0 * shear * de - sy,
+            -3.0 * shear - dsde - dsdr / dt,
+            sy,
+        )
+    };
+    let (mut lo, mut hi) = (0.0, seq / (3.0 * shear));
+    let mut de = 0.5 * (seq - sy0) / (3.0 * shear);
+    let mut sy = sy0;
+    for _ in 0..60 {
+        let (fv, dfv, s) = f(de);
+        sy = s;
+        if fv > 0.0 {
+            lo = de;
+        } else {
+            hi = de;
+        }
+        if fv.abs() <= 1e-12 * seq || hi - lo <= 1e-15 * hi {
+            break;
+        }
+        let newton = de - fv / dfv;
+        de = if newton > lo && newton < hi && dfv < 0.0 {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    let scale = ((seq - 3.0 * shear * de) / seq).max(0.0);
+    Plastic {
+        sdev: s_trial * scale,
+        d_eps: de,
+        sigma_y: sy,
+    }
+}
+
+/// Smallest fracture strain used where eq. 20 goes to zero or below at high triaxiality: such a
+/// particle fails within a few steps of plastic flow instead of at once.
+pub const MIN_FRACTURE_STRAIN: f64 = 1e-3;
+
+/// Johnson–Cook fracture strain (eq. 20) for triaxiality σ* = −p/σ_eq, plastic strain rate and
+/// temperature; the rate logarithm is held at 0 below ε̇0f as in eq. 18.
+pub fn fracture_strain(
+    d: &JohnsonCookDamage,
+    jc: &JohnsonCook,
+    triax: f64,
+    rate: f64,
+    t: f64,
+) -> f64 {
+    let rate_term = if rate > d.ref_strain_rate_s {
+        1.0 + d.d4 * (rate / d.ref_strain_rate_s).ln()
+    } else {
+        1.0
+    };
+    let ef = (d.d1 + d.d2 * (d.d3 * triax).exp())
+        * rate_term
+        * (1.0 + d.d5 * homologous_temperature(jc, t));
+    ef.max(MIN_FRACTURE_STRAIN)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::Material;
+
+    #[test]
+    fn radial_return_lands_on_the_yield_surface() {
+        let m = Material::aisi304();
+        let jc = m.plasticity.clone().unwrap();
+        let g = m.shear_modulus();
+        let s = Matrix::new(3e9, 1e9, 1e9, -1e9);
+        let dt = 1e-9;
+        let r = radial_return(s, g, &jc, 0.1, dt, 400.0);
+        assert!(r.d_eps > 0.0);
+        let (sy, _, _) = jc_yield(&jc, 0.1 + r.d_eps, r.d_eps / dt, 400.0);
+        assert!(
+            (von_mises(&r.sdev) - sy).abs() < 1e-6 * sy,
+            "{} vs {sy}",
+            von_mises(&r.sdev)
+        );
+        // Consistency: the stress drop is 3GΔε.
+        assert!((von_mises(&s) - von_mises(&r.sdev) - 3.0 * g * r.d_eps).abs() < 1e-6 * sy);
+    }
+
+    #[test]
+    fn elastic_state_is_untouched() {
+        let m = Material::aisi304();
+        let jc = m.plasticity.clone().unwrap();
+        let s = Matrix::new(1e8, 0.0, 0.0, -1e8);
+        let r = radial_return(s, m.shear_modulus(), &jc, 0.0, 1e-9, 293.0);
+        assert_eq!(r.d_eps, 0.0);
+        assert_eq!(r.sdev, s);
+    }
+
+    #[test]
+    fn yield_is_zero_at_melt_and_rate_term_never_softens() {
+        let jc = Material::aisi304().plasticity.unwrap();
+        assert_eq!(jc_yield(&jc, 0.2, 1e3, jc.t_melt_k + 10.0).0, 0.0);
+        let slow = jc_yield(&jc, 0.0, 1e-8, 293.0).0;
+        assert_eq!(slow, jc.a_pa);
+    }
+
+    #[test]
+    fn fracture_strain_follows_triaxiality() {
+        let m = Material::aisi304();
+        let (d, jc) = (m.damage.unwrap(), m.plasticity.unwrap());
+        let comp = fracture_strain(&d, &jc, -1.0, 1.0, 293.0);
+        let tens = fracture_strain(&d, &jc, 1.0, 1.0, 293.0);
+        assert!(
+            comp > tens,
+            "compression must be more ductile: {comp} vs {tens}"
+        );
+        assert!(
+            (tens - (-0.7786 + 2.5588 * (-0.3607f64).exp()) * (1.0 - 0.0191 * (1000.0f64).ln()))
+                .abs()
+                < 1e-12
+        );
+    }
+}

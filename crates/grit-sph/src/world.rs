@@ -1,0 +1,1344 @@
+//! The world: bodies, particles and contacts, and the explicit step that advances them
+//! (DESIGN.md "Engine step"; seed section 2 for the solid, section 3 for contact).
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::body::{Body, BodyKind, ExternalForce, Motion, Rigid};
+use crate::contact::{self, ContactPair, ContactParams};
+use crate::error::{InputError, SimError};
+use crate::geometry::Polygon;
+use crate::kernel::{Kernel, KernelKind};
+use crate::material::Material;
+use crate::math::{cross, omega_cross, outer, rotate, Matrix, Vector};
+use crate::neighbours::{self, NeighbourLists};
+use crate::particles::{dev_contract, von_mises, Particles, BOUNDARY, KINEMATIC};
+use crate::physics;
+use crate::timers::{Stage, Timers};
+
+/// Numerical settings of a world; defaults are the seed's choices.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Settings {
+    /// Initial particle spacing Δx (m); also the contact equilibrium distance (section 3.1).
+    pub spacing_m: f64,
+    /// Smoothing length over spacing, h/Δx (seed: 1.3).
+    pub h_over_dx: f64,
+    /// Kernel function (seed: quintic spline, eq. 4).
+    pub kernel: KernelKind,
+    /// Courant number of the time step dt = CFL · h / max(c + |v|).
+    pub cfl: f64,
+    /// Gravity (m/s²).
+    pub gravity_m_s2: Vector,
+    /// Hourglass coefficient α of eq. 16 (0 switches hourglass control off).
+    pub hourglass: f64,
+    /// Steps between Shepard density filters (eq. 12; seed: 40; 0 switches it off).
+    pub shepard_interval: u32,
+    /// Verlet skin over Δx: lists are rebuilt once a particle has moved half of it.
+    pub skin_over_dx: f64,
+    /// Upper bound of the time step (s).
+    pub dt_max_s: f64,
+    /// Fraction of plastic work turned into heat (Taylor–Quinney coefficient).
+    pub taylor_quinney: f64,
+    /// Initial temperature of deformable bodies (K).
+    pub temperature_k: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            spacing_m: 8e-6,
+            h_over_dx: 1.3,
+            kernel: KernelKind::Quintic,
+            cfl: 0.3,
+            gravity_m_s2: Vector::zeros(),
+            hourglass: 0.1,
+            shepard_interval: 40,
+            skin_over_dx: 0.5,
+            dt_max_s: 1e-3,
+            taylor_quinney: 0.9,
+            temperature_k: 293.0,
+        }
+    }
+}
+
+impl Settings {
+    /// Checks that every setting is usable; the error names the field.
+    pub fn validate(&self) -> Result<(), InputError> {
+        let pos = |f: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(InputError::new(
+                    f,
+                    format!("must be a finite number > 0, got {v}"),
+                ))
+            }
+        };
+        pos("spacing_m", self.spacing_m)?;
+        pos("h_over_dx", self.h_over_dx)?;
+        pos("cfl", self.cfl)?;
+        if self.cfl > 1.0 {
+            return Err(InputError::new(
+                "cfl",
+                format!("must be at most 1 for an explicit step, got {}", self.cfl),
+            ));
+        }
+        pos("skin_over_dx", self.skin_over_dx)?;
+        pos("dt_max_s", self.dt_max_s)?;
+        pos("temperature_k", self.temperature_k)?;
+        if !(self.hourglass.is_finite() && self.hourglass >= 0.0) {
+            return Err(InputError::new(
+                "hourglass",
+                format!("must be >= 0, got {}", self.hourglass),
+            ));
+        }
+        if !(self.taylor_quinney.is_finite() && (0.0..=1.0).contains(&self.taylor_quinney)) {
+            return Err(InputError::new(
+                "taylor_quinney",
+                format!("must lie in [0, 1], got {}", self.taylor_quinney),
+            ));
+        }
+        if !(self.gravity_m_s2.x.is_finite() && self.gravity_m_s2.y.is_finite()) {
+            return Err(InputError::new("gravity_m_s2", "must be finite"));
+        }
+        Ok(())
+    }
+}
+
+/// Energy of the world and what the numerics have added or taken (J/m, per unit depth).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Energy {
+    /// Kinetic energy of deformable particles and rigid bodies.
+    pub kinetic: f64,
+    /// Elastic strain energy: V (p²/2K + s:s/4G) summed over deformable particles.
+    pub elastic: f64,
+    /// Energy stored in the contact repulsion springs.
+    pub contact: f64,
+    /// Potential energy in gravity.
+    pub gravity: f64,
+}
+
+impl Energy {
+    /// Kinetic plus elastic plus contact plus gravity.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.contact + self.gravity
+    }
+}
+
+/// Running totals of work done by numerical devices (J/m); negative means dissipated.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct NumericalWork {
+    /// Work of the hourglass forces (eq. 16).
+    pub hourglass: f64,
+    /// Change of elastic energy at the Shepard density filter (eq. 12).
+    pub density_filter: f64,
+    /// Work of the contact dashpots.
+    pub contact_damping: f64,
+    /// Plastic work (heat and stored work of plasticity).
+    pub plastic: f64,
+}
+
+/// Per-body constants the stages need, looked up by particle.
+#[derive(Debug, Clone, Copy, Default)]
+struct BodyConst {
+    deformable: bool,
+    bulk: f64,
+    shear: f64,
+    youngs: f64,
+    sound: f64,
+}
+
+/// Scratch arrays rebuilt every step (not part of a checkpoint).
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    shepard: Vec<f64>,
+    lcorr: Vec<Matrix>,
+    gradv: Vec<Matrix>,
+    acc: Vec<Vector>,
+    contact_force: Vec<Vector>,
+    penetration: Vec<f64>,
+}
+
+/// A 2D SPH scene: bodies, their particles, contact pairs, time.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct World {
+    settings: Settings,
+    kernel: Kernel,
+    bodies: Vec<Body>,
+    contacts: Vec<ContactPair>,
+    particles: Particles,
+    time: f64,
+    steps: u64,
+    dt: f64,
+    next_id: u32,
+    work: NumericalWork,
+    /// Positions at the last neighbour build.
+    x_build: Vec<Vector>,
+    #[serde(skip)]
+    nbrs: NeighbourLists,
+    #[serde(skip)]
+    nbrs_valid: bool,
+    #[serde(skip)]
+    scratch: Scratch,
+    #[serde(skip)]
+    timers: Timers,
+}
+
+impl World {
+    /// An empty world with validated settings.
+    pub fn new(settings: Settings) -> Result<Self, InputError> {
+        settings.validate()?;
+        let kernel = Kernel::new(settings.kernel, settings.h_over_dx * settings.spacing_m);
+        Ok(World {
+            settings,
+            kernel,
+            bodies: Vec::new(),
+            contacts: Vec::new(),
+            particles: Particles::default(),
+            time: 0.0,
+            steps: 0,
+            dt: 0.0,
+            next_id: 0,
+            work: NumericalWork::default(),
+            x_build: Vec::new(),
+            nbrs: NeighbourLists::default(),
+            nbrs_valid: false,
+            scratch: Scratch::default(),
+            timers: Timers::default(),
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    /// The kernel in use.
+    pub fn kernel(&self) -> &Kernel {
+        &self.kernel
+    }
+    /// Smoothing length h (m).
+    pub fn h(&self) -> f64 {
+        self.kernel.h
+    }
+    /// All bodies.
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+    /// One body, mutable (to change a rigid body's motion or external force between phases).
+    pub fn body_mut(&mut self, b: usize) -> &mut Body {
+        &mut self.bodies[b]
+    }
+    /// All particles.
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    /// The time step the next step will take (s); 0 before the first step.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// Per-stage timers.
+    pub fn timers(&self) -> &Timers {
+        &self.timers
+    }
+    /// Per-stage timers, mutable (to reset between measurements).
+    pub fn timers_mut(&mut self) -> &mut Timers {
+        &mut self.timers
+    }
+    /// Work of numerical devices so far.
+    pub fn numerical_work(&self) -> NumericalWork {
+        self.work
+    }
+    /// The contact pairs.
+    pub fn contacts(&self) -> &[ContactPair] {
+        &self.contacts
+    }
+    /// Parameters of contact pair `c`, mutable (to end a settling phase's damping, say).
+    pub fn contact_params_mut(&mut self, c: usize) -> &mut ContactParams {
+        &mut self.contacts[c].params
+    }
+    /// Contact force on each particle in the last step (N/m); empty before the first step.
+    pub fn contact_forces(&self) -> &[Vector] {
+        &self.scratch.contact_force
+    }
+    /// Neighbour count of each particle as last built (for reports).
+    pub fn neighbour_pairs(&self) -> usize {
+        self.nbrs.pairs()
+    }
+
+    fn push_particle(
+        &mut self,
+        body: usize,
+        x: Vector,
+        v: Vector,
+        mass: f64,
+        rho: f64,
+        flags: u8,
+        local: Vector,
+    ) {
+        let p = &mut self.particles;
+        p.id.push(self.next_id);
+        self.next_id += 1;
+        p.body.push(body as u32);
+        p.flags.push(flags);
+        p.pos.push(x);
+        p.vel.push(v);
+        p.mass.push(mass);
+        p.rho.push(rho);
+        p.rho0.push(rho);
+        p.sdev.push(Matrix::zeros());
+        p.eps_p.push(0.0);
+        p.eps_p_rate.push(0.0);
+        p.temp.push(self.settings.temperature_k);
+        p.damage.push(0.0);
+        p.def_grad.push(Matrix::identity());
+        p.x_ref.push(x);
+        p.local.push(local);
+        for c in &mut self.contacts {
+            c.spring.push(Vector::zeros());
+            c.penetration.push(0.0);
+        }
+        self.nbrs_valid = false;
+    }
+
+    /// Adds a deformable body of particles at `points`, each standing for `volume_m2` (area per
+    /// unit depth); returns its index. The body's surface particles are found geometrically.
+    pub fn add_deformable(
+        &mut self,
+        name: &str,
+        material: Material,
+        points: &[Vector],
+        volume_m2: &[f64],
+        velocity_m_s: Vector,
+    ) -> Result<usize, InputError> {
+        material.validate()?;
+        if points.is_empty() {
+            return Err(InputError::new(
+                format!("{name}.points"),
+                "a body needs at least one particle",
+            ));
+        }
+        if points.len() != volume_m2.len() {
+            return Err(InputError::new(
+                format!("{name}.volume_m2"),
+                "needs one volume per point",
+            ));
+        }
+        if let Some(k) = volume_m2.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(InputError::new(
+                format!("{name}.volume_m2[{k}]"),
+                "must be a finite number > 0",
+            ));
+        }
+        let b = self.bodies.len();
+        let rho = material.density_kg_m3;
+        self.bodies.push(Body {
+            name: name.to_string(),
+            kind: BodyKind::Deformable {
+                material,
+                boundary_motion: Motion::Fixed,
+            },
+            removed_mass_kg_m: 0.0,
+            removed_particles: 0,
+        });
+        for (x, v) in points.iter().zip(volume_m2) {
+            self.push_particle(b, *x, velocity_m_s, rho * v, rho, 0, Vector::zeros());
+        }
+        Ok(b)
+    }
+
+    /// Adds a deformable body filling `polygon` on a square lattice of the world's spacing.
+    pub fn add_deformable_polygon(
+        &mut self,
+        name: &str,
+        material: Material,
+        polygon: &Polygon,
+        lattice_origin: Vector,
+        velocity_m_s: Vector,
+    ) -> Result<usize, InputError> {
+        let dx = self.settings.spacing_m;
+        let pts = polygon.fill_lattice(dx, lattice_origin);
+        let vols = vec![dx * dx; pts.len()];
+        self.add_deformable(name, material, &pts, &vols, velocity_m_s)
+    }
+
+    /// Makes the particles of deformable body `b` that satisfy `select` kinematic: they move
+    /// with `motion` (a prescribed-motion boundary) and take no forces.
+    pub fn set_kinematic(
+        &mut self,
+        b: usize,
+        motion: Motion,
+        select: impl Fn(Vector) -> bool,
+    ) -> Result<usize, InputError> {
+        match &mut self.bodies[b].kind {
+            BodyKind::Deformable {
+                boundary_motion, ..
+            } => *boundary_motion = motion,
+            BodyKind::Rigid(_) => {
+                return Err(InputError::new(
+                    "kinematic",
+                    "only deformable bodies have kinematic particles",
+                ))
+            }
+        }
+        let mut n = 0;
+        for i in 0..self.particles.len() {
+            if self.particles.body[i] as usize == b && select(self.particles.pos[i]) {
+                self.particles.flags[i] |= KINEMATIC;
+                n += 1;
+            }
+        }
+        Ok(n)
+    }
+
+    /// Adds a rigid polygon of `density_kg_m3` (mass and inertia from the polygon itself),
+    /// filled with boundary-conforming particle layers; returns its index.
+    pub fn add_rigid(
+        &mut self,
+        name: &str,
+        polygon: &Polygon,
+        density_kg_m3: f64,
+        velocity_m_s: Vector,
+        omega_rad_s: f64,
+        motion: Motion,
+    ) -> Result<usize, InputError> {
+        if !(density_kg_m3.is_finite() && density_kg_m3 > 0.0) {
+            return Err(InputError::new(
+                format!("{name}.density_kg_m3"),
+                format!("must be > 0, got {density_kg_m3}"),
+            ));
+        }
+        let dx = self.settings.spacing_m;
+        let (pts, boundary) = polygon.fill_layered(dx);
+        if pts.is_empty() {
+            return Err(InputError::new(
+                format!("{name}.vertices_m"),
+                "polygon is too small for the particle spacing",
+            ));
+        }
+        let mass = density_kg_m3 * polygon.area();
+        let inertia = density_kg_m3 * polygon.polar_moment();
+        let com = polygon.centroid();
+        let b = self.bodies.len();
+        self.bodies.push(Body {
+            name: name.to_string(),
+            kind: BodyKind::Rigid(Rigid {
+                mass_kg_m: mass,
+                inertia_kg_m: inertia,
+                com_m: com,
+                angle_rad: 0.0,
+                velocity_m_s,
+                omega_rad_s,
+                motion,
+                external: ExternalForce::default(),
+                contact_force_n_m: Vector::zeros(),
+                contact_torque_n: 0.0,
+            }),
+            removed_mass_kg_m: 0.0,
+            removed_particles: 0,
+        });
+        let mp = mass / pts.len() as f64;
+        for (x, isb) in pts.iter().zip(boundary) {
+            let r = x - com;
+            let v = velocity_m_s + omega_cross(omega_rad_s, r);
+            self.push_particle(
+                b,
+                *x,
+                v,
+                mp,
+                density_kg_m3,
+                if isb { BOUNDARY } else { 0 },
+                r,
+            );
+        }
+        Ok(b)
+    }
+
+    /// Sets the external force on rigid body `b`.
+    pub fn set_external_force(&mut self, b: usize, f: ExternalForce) -> Result<(), InputError> {
+        match self.bodies[b].rigid_mut() {
+            Some(r) => {
+                r.external = f;
+                Ok(())
+            }
+            None => Err(InputError::new(
+                "external_force",
+                "only rigid bodies take an external force",
+            )),
+        }
+    }
+
+    /// Declares that rigid `primary` and `secondary` touch with the seed's contact (section 3).
+    pub fn add_contact(
+        &mut self,
+        primary: usize,
+        secondary: usize,
+        params: ContactParams,
+    ) -> Result<usize, InputError> {
+        if primary >= self.bodies.len() || secondary >= self.bodies.len() || primary == secondary {
+            return Err(InputError::new(
+                "contact",
+                "primary and secondary must be two different existing bodies",
+            ));
+        }
+        if !self.bodies[primary].is_rigid() {
+            return Err(InputError::new(
+                "contact.primary",
+                "the primary body must be rigid: its surface gives the normal",
+            ));
+        }
+        if !(params.friction.is_finite() && params.friction >= 0.0) {
+            return Err(InputError::new(
+                "contact.friction",
+                format!("must be >= 0, got {}", params.friction),
+            ));
+        }
+        if !(params.damping_ratio.is_finite() && params.damping_ratio >= 0.0) {
+            return Err(InputError::new("contact.damping_ratio", "must be >= 0"));
+        }
+        let k_r = match params.normal_stiffness_pa {
+            Some(k) => k,
+            None => match self.bodies[secondary].material() {
+                // Spring of period equal to the CFL step: m/k = ρΔx²/k = (h/c)² ⇒ k = ρc²/(h/Δx)².
+                Some(m) => {
+                    m.density_kg_m3 * m.sound_speed().powi(2) / self.settings.h_over_dx.powi(2)
+                }
+                None => {
+                    return Err(InputError::new(
+                        "contact.normal_stiffness_pa",
+                        "must be given when both bodies are rigid",
+                    ))
+                }
+            },
+        };
+        let k_f = params.tangential_stiffness_pa.unwrap_or(k_r);
+        if !(k_r.is_finite() && k_r > 0.0 && k_f.is_finite() && k_f > 0.0) {
+            return Err(InputError::new(
+                "contact.normal_stiffness_pa",
+                "stiffnesses must be > 0",
+            ));
+        }
+        self.contacts.push(ContactPair {
+            primary,
+            secondary,
+            params,
+            k_r,
+            k_f,
+            spring: vec![Vector::zeros(); self.particles.len()],
+            penetration: vec![0.0; self.particles.len()],
+        });
+        self.nbrs_valid = false;
+        Ok(self.contacts.len() - 1)
+    }
+
+    fn body_consts(&self) -> Vec<BodyConst> {
+        self.bodies
+            .iter()
+            .map(|b| match b.material() {
+                Some(m) => BodyConst {
+                    deformable: true,
+                    bulk: m.bulk_modulus(),
+                    shear: m.shear_modulus(),
+                    youngs: m.youngs_modulus_pa,
+                    sound: m.sound_speed(),
+                },
+                None => BodyConst::default(),
+            })
+            .collect()
+    }
+
+    /// Kinetic, elastic, contact-spring and gravity energy (J/m).
+    pub fn energy(&self) -> Energy {
+        let bc = self.body_consts();
+        let p = &self.particles;
+        let mut e = Energy::default();
+        for i in 0..p.len() {
+            let b = p.body[i] as usize;
+            if !bc[b].deformable {
+                continue;
+            }
+            e.kinetic += 0.5 * p.mass[i] * p.vel[i].norm_squared();
+            let vol = p.mass[i] / p.rho[i];
+            let pr = p.pressure(i, bc[b].bulk);
+            e.elastic += vol
+                * (pr * pr / (2.0 * bc[b].bulk) + dev_contract(&p.sdev[i]) / (4.0 * bc[b].shear));
+            e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
+        }
+        for b in &self.bodies {
+            if let Some(r) = b.rigid() {
+                if r.motion == Motion::Free {
+                    e.kinetic += 0.5 * r.mass_kg_m * r.velocity_m_s.norm_squared()
+                        + 0.5 * r.inertia_kg_m * r.omega_rad_s * r.omega_rad_s;
+                    e.gravity -= r.mass_kg_m * self.settings.gravity_m_s2.dot(&r.com_m);
+                }
+            }
+        }
+        for c in &self.contacts {
+            for i in 0..p.len().min(self.scratch.penetration.len()) {
+                if p.body[i] as usize == c.secondary && self.scratch.penetration[i] > 0.0 {
+                    e.contact += 0.5 * c.k_r * self.scratch.penetration[i].powi(2)
+                        + 0.5 * c.spring[i].norm_squared() * c.k_f;
+                }
+            }
+        }
+        e
+    }
+
+    /// Total linear momentum of deformable particles and free rigid bodies (kg·m/s per m).
+    pub fn momentum(&self) -> Vector {
+        let p = &self.particles;
+        let mut m = Vector::zeros();
+        for i in 0..p.len() {
+            if self.bodies[p.body[i] as usize].material().is_some() {
+                m += p.vel[i] * p.mass[i];
+            }
+        }
+        for b in &self.bodies {
+            if let Some(r) = b.rigid() {
+                if r.motion == Motion::Free {
+                    m += r.velocity_m_s * r.mass_kg_m;
+                }
+            }
+        }
+        m
+    }
+
+    /// Resets temperature of deformable bodies to the initial one (between impacts, section 4).
+    pub fn reset_temperature(&mut self) {
+        let t = self.settings.temperature_k;
+        for x in &mut self.particles.temp {
+            *x = t;
+        }
+    }
+
+    /// Removes every particle of body `b` and the body's contacts (the old grain, section 4).
+    /// Body indices of other bodies stay valid: the body entry remains, empty.
+    pub fn clear_body(&mut self, b: usize) {
+        let keep: Vec<bool> = self
+            .particles
+            .body
+            .iter()
+            .map(|&x| x as usize != b)
+            .collect();
+        self.retain_particles(&keep);
+        self.contacts.retain(|c| c.primary != b && c.secondary != b);
+        self.nbrs_valid = false;
+    }
+
+    fn retain_particles(&mut self, keep: &[bool]) {
+        self.particles.retain(keep);
+        for c in &mut self.contacts {
+            let mut k = 0;
+            for i in 0..c.spring.len() {
+                if keep[i] {
+                    c.spring[k] = c.spring[i];
+                    c.penetration[k] = c.penetration[i];
+                    k += 1;
+                }
+            }
+            c.spring.truncate(k);
+            c.penetration.truncate(k);
+        }
+        self.nbrs_valid = false;
+    }
+
+    /// Rebuilds neighbour lists: deformable particles see their own body and the primary
+    /// boundary particles they can touch; rigid secondary boundary particles see their primaries.
+    fn rebuild_neighbours(&mut self) {
+        let nb = self.bodies.len();
+        // relation[a * nb + b]: can a particle of body a list one of body b?
+        let mut relation = vec![false; nb * nb];
+        let mut is_secondary = vec![false; nb];
+        let mut is_primary = vec![false; nb];
+        for (a, body) in self.bodies.iter().enumerate() {
+            if !body.is_rigid() {
+                relation[a * nb + a] = true;
+            }
+        }
+        for c in &self.contacts {
+            relation[c.secondary * nb + c.primary] = true;
+            is_secondary[c.secondary] = true;
+            is_primary[c.primary] = true;
+        }
+        let p = &self.particles;
+        let n = p.len();
+        let rigid: Vec<bool> = self.bodies.iter().map(|b| b.is_rigid()).collect();
+        let searcher: Vec<bool> = (0..n)
+            .map(|i| {
+                let b = p.body[i] as usize;
+                !rigid[b] || (is_secondary[b] && p.flags[i] & BOUNDARY != 0)
+            })
+            .collect();
+        let candidate: Vec<bool> = (0..n)
+            .map(|i| {
+                let b = p.body[i] as usize;
+                !rigid[b] || (is_primary[b] && p.flags[i] & BOUNDARY != 0)
+            })
+            .collect();
+        let radius = self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m;
+        let body = &p.body;
+        self.nbrs = neighbours::build(&p.pos, &searcher, &candidate, radius, |i, j| {
+            relation[body[i] as usize * nb + body[j] as usize]
+        });
+        self.x_build = p.pos.clone();
+        self.nbrs_valid = true;
+    }
+
+    fn needs_rebuild(&self) -> bool {
+        if !self.nbrs_valid || self.x_build.len() != self.particles.len() {
+            return true;
+        }
+        let half = 0.5 * self.settings.skin_over_dx * self.settings.spacing_m;
+        let lim = half * half;
+        self.particles
+            .pos
+            .par_iter()
+            .zip(&self.x_build)
+            .any(|(x, x0)| (x - x0).norm_squared() > lim)
+    }
+
+    /// Stable time step: CFL on the material signal speed plus particle speed, and the
+    /// contact springs' period.
+    fn compute_dt(&self) -> f64 {
+        let bc = self.body_consts();
+        let p = &self.particles;
+        let h = self.kernel.h;
+        let smax = (0..p.len())
+            .into_par_iter()
+            .filter(|&i| bc[p.body[i] as usize].deformable)
+            .map(|i| bc[p.body[i] as usize].sound + p.vel[i].norm())
+            .reduce(|| 0.0, f64::max);
+        let mut dt = self.settings.dt_max_s;
+        if smax > 0.0 {
+            dt = dt.min(self.settings.cfl * h / smax);
+        }
+        for c in &self.contacts {
+            let m_min = (0..p.len())
+                .filter(|&i| {
+                    let b = p.body[i] as usize;
+                    b == c.secondary || (b == c.primary && p.flags[i] & BOUNDARY != 0)
+                })
+                .map(|i| p.mass[i])
+                .fold(f64::INFINITY, f64::min);
+            if m_min.is_finite() {
+                dt = dt.min(self.settings.cfl * (m_min / (c.k_r + c.k_f)).sqrt() * 2.0);
+            }
+        }
+        dt
+    }
+
+    /// Advances the world by one explicit step (DESIGN.md "Engine step").
+    pub fn step(&mut self) -> Result<(), SimError> {
+        if self.dt == 0.0 {
+            self.dt = self.compute_dt();
+        }
+        let dt = self.dt;
+        let n = self.particles.len();
+        let bc = self.body_consts();
+
+        let mut timers = std::mem::take(&mut self.timers);
+        if self.needs_rebuild() {
+            timers.time(Stage::Neighbours, || self.rebuild_neighbours());
+        }
+        timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
+        timers.time(Stage::Rates, || self.rates(&bc));
+        timers.time(Stage::Stress, || self.stress(&bc, dt));
+        timers.time(Stage::Forces, || self.forces(&bc, dt));
+        let contact = timers.time(Stage::Contact, || self.contact(dt));
+        timers.time(Stage::Rigid, || self.rigid(dt));
+        let checked = timers.time(Stage::Integrate, || self.integrate(&bc, dt));
+        self.timers = timers;
+        contact?;
+        checked?;
+        self.time += dt;
+        self.steps += 1;
+        let mut timers = std::mem::take(&mut self.timers);
+        let r = timers.time(Stage::Housekeeping, || self.housekeeping(&bc));
+        self.timers = timers;
+        debug_assert!(self.particles.len() <= n);
+        r
+    }
+
+    /// Steps until `t_end` (s) or until `stop` says so; returns the number of steps.
+    pub fn run_until(
+        &mut self,
+        t_end: f64,
+        mut stop: impl FnMut(&World) -> bool,
+    ) -> Result<u64, SimError> {
+        let s0 = self.steps;
+        while self.time < t_end && !stop(self) {
+            self.step()?;
+        }
+        Ok(self.steps - s0)
+    }
+
+    /// Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator) and Bonet–Lok matrices L_i (eq. 8).
+    fn kernel_sums(&mut self, bc: &[BodyConst]) {
+        let p = &self.particles;
+        let nl = &self.nbrs;
+        let k = &self.kernel;
+        let w0 = k.w(0.0);
+        let n = p.len();
+        let out: Vec<(f64, Matrix)> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let bi = p.body[i];
+                if !bc[bi as usize].deformable {
+                    return (1.0, Matrix::identity());
+                }
+                let xi = p.pos[i];
+                let mut g = p.mass[i] / p.rho[i] * w0;
+                let mut m = Matrix::zeros();
+                for &j in nl.of(i) {
+                    let j = j as usize;
+                    if p.body[j] != bi {
+                        continue;
+                    }
+                    let xij = xi - p.pos[j];
+                    let r = xij.norm();
+                    let (w, dw) = k.w_dw(r);
+                    let vj = p.mass[j] / p.rho[j];
+                    g += vj * w;
+                    if r > 0.0 {
+                        let grad = xij * (dw / r);
+                        m += outer(-xij, grad) * vj;
+                    }
+                }
+                (g, correction(m))
+            })
+            .collect();
+        let s = &mut self.scratch;
+        s.shepard.clear();
+        s.lcorr.clear();
+        for (g, l) in out {
+            s.shepard.push(g);
+            s.lcorr.push(l);
+        }
+    }
+
+    /// Velocity gradient with the corrected kernel gradient (eq. 15, 7).
+    fn rates(&mut self, bc: &[BodyConst]) {
+        let p = &self.particles;
+        let nl = &self.nbrs;
+        let k = &self.kernel;
+        let lc = &self.scratch.lcorr;
+        let out: Vec<Matrix> = (0..p.len())
+            .into_par_iter()
+            .map(|i| {
+                let bi = p.body[i];
+                if !bc[bi as usize].deformable {
+                    return Matrix::zeros();
+                }
+                let xi = p.pos[i];
+                let vi = p.vel[i];
+                let mut gv = Matrix::zeros();
+                for &j in nl.of(i) {
+                    let j = j as usize;
+                    if p.body[j] != bi {
+                        continue;
+                    }
+                    let xij = xi - p.pos[j];
+                    let r = xij.norm();
+                    if r == 0.0 {
+                        continue;
+                    }
+                    let (_, dw) = k.w_dw(r);
+                    let vj = p.mass[j] / p.rho[j];
+                    gv += outer(p.vel[j] - vi, xij * (dw / r)) * vj;
+                }
+                gv * lc[i].transpose()
+            })
+            .collect();
+        self.scratch.gradv = out;
+    }
+
+    /// Continuity (eq. 5 as ρ̇ = −ρ tr ∇v), Jaumann rate (eq. 13), radial return with Johnson–Cook
+    /// yield (eq. 18), adiabatic heating, damage (eqs. 19–20), and the deformation gradient the
+    /// hourglass stiffness compares against.
+    fn stress(&mut self, bc: &[BodyConst], dt: f64) {
+        let gv = &self.scratch.gradv;
+        let bodies = &self.bodies;
+        let beta = self.settings.taylor_quinney;
+        let p = &mut self.particles;
+        let plastic_work: f64 = p
+            .rho
+            .par_iter_mut()
+            .zip(p.sdev.par_iter_mut())
+            .zip(p.eps_p.par_iter_mut())
+            .zip(p.eps_p_rate.par_iter_mut())
+            .zip(p.temp.par_iter_mut())
+            .zip(p.damage.par_iter_mut())
+            .zip(p.def_grad.par_iter_mut())
+            .zip(p.body.par_iter())
+            .zip(p.mass.par_iter())
+            .zip(p.rho0.par_iter())
+            .enumerate()
+            .map(
+                |(i, (((((((((rho, s), ep), epr), temp), dmg), fdef), &b), &m), &rho0))| {
+                    let c = bc[b as usize];
+                    if !c.deformable {
+                        return 0.0;
+                    }
+                    let l = gv[i];
+                    let d = (l + l.transpose()) * 0.5;
+                    let w = (l - l.transpose()) * 0.5;
+                    let trd = d.trace();
+                    *rho *= 1.0 - dt * trd;
+                    *fdef += l * *fdef * dt;
+                    let dev = d - Matrix::identity() * (trd / 3.0);
+                    let s_trial = *s + (dev * (2.0 * c.shear) + w * *s - *s * w) * dt;
+                    let mat = bodies[b as usize]
+                        .material()
+                        .expect("deformable body has a material");
+                    match &mat.plasticity {
+                        None => {
+                            *s = s_trial;
+                            0.0
+                        }
+                        Some(jc) => {
+                            let r = physics::radial_return(s_trial, c.shear, jc, *ep, dt, *temp);
+                            *s = r.sdev;
+                            *epr = r.d_eps / dt;
+                            if r.d_eps > 0.0 {
+                                let wp = r.sigma_y * r.d_eps; // plastic work per volume
+                                if let Some(dm) = &mat.damage {
+                                    let seq = von_mises(&r.sdev);
+                                    let pr = c.bulk * (*rho / rho0 - 1.0);
+                                    let triax = if seq > 0.0 { -pr / seq } else { 0.0 };
+                                    let ef = physics::fracture_strain(dm, jc, triax, *epr, *temp);
+                                    *dmg += r.d_eps / ef;
+                                }
+                                *ep += r.d_eps;
+                                *temp += beta * wp / (*rho * mat.heat_capacity_j_kgk);
+                                wp * m / *rho
+                            } else {
+                                0.0
+                            }
+                        }
+                    }
+                },
+            )
+            .collect::<Vec<f64>>()
+            .iter()
+            .sum();
+        self.work.plastic -= plastic_work;
+    }
+
+    /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9), the
+    /// hourglass force (eq. 16) and gravity.
+    fn forces(&mut self, bc: &[BodyConst], dt: f64) {
+        let p = &self.particles;
+        let nl = &self.nbrs;
+        let k = &self.kernel;
+        let alpha = self.settings.hourglass;
+        let g = self.settings.gravity_m_s2;
+        let h = k.h;
+        let radius = k.radius();
+        let sh = &self.scratch.shepard;
+        let gv = &self.scratch.gradv;
+        // σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
+        let sig: Vec<Matrix> = (0..p.len())
+            .into_par_iter()
+            .map(|i| {
+                let c = bc[p.body[i] as usize];
+                if !c.deformable {
+                    return Matrix::zeros();
+                }
+                let pr = p.pressure(i, c.bulk);
+                (p.sdev[i] - Matrix::identity() * pr) / (p.rho[i] * p.rho[i] * sh[i])
+            })
+            .collect();
+        let out: Vec<(Vector, f64)> = (0..p.len())
+            .into_par_iter()
+            .map(|i| {
+                let bi = p.body[i];
+                let c = bc[bi as usize];
+                if !c.deformable {
+                    return (Vector::zeros(), 0.0);
+                }
+                let xi = p.pos[i];
+                let vi = p.vel[i];
+                let voli = p.mass[i] / p.rho[i];
+                let mut a = Vector::zeros();
+                let mut fhg = Vector::zeros();
+                for &j in nl.of(i) {
+                    let j = j as usize;
+                    if p.body[j] != bi {
+                        continue;
+                    }
+                    let xij = xi - p.pos[j];
+                    let r = xij.norm();
+                    if r == 0.0 {
+                        continue;
+                    }
+                    let (w, dw) = k.w_dw(r);
+                    let grad = xij * (dw / r);
+                    a += (sig[i] + sig[j]) * grad * p.mass[j];
+                    if alpha > 0.0 && w > 0.0 {
+                        let e = xij / r;
+                        let volj = p.mass[j] / p.rho[j];
+                        let cij = alpha * voli * volj * w / (r * r);
+                        // Viscous part: velocity error against the mean velocity gradient.
+                        let vij = vi - p.vel[j];
+                        let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
+                        let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
+                        // Stiffness part: separation error against the mean deformation gradient.
+                        let xr = p.x_ref[i] - p.x_ref[j];
+                        let stiff = if xr.norm() < radius {
+                            let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
+                            c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
+                        } else {
+                            0.0
+                        };
+                        fhg -= e * (cij * 0.5 * (stiff + visc));
+                    }
+                }
+                let acc = a + fhg / p.mass[i] + g;
+                (acc, fhg.dot(&vi) * dt)
+            })
+            .collect();
+        let s = &mut self.scratch;
+        s.acc.clear();
+        let mut hg = 0.0;
+        for (a, wk) in out {
+            s.acc.push(a);
+            hg += wk;
+        }
+        self.work.hourglass += hg;
+    }
+
+    /// Contact detection and forces for every pair (eqs. 21–29); reactions collected per rigid
+    /// body in particle order, so the sums do not depend on the thread count.
+    fn contact(&mut self, dt: f64) -> Result<(), SimError> {
+        let n = self.particles.len();
+        let s = &mut self.scratch;
+        s.contact_force.clear();
+        s.contact_force.resize(n, Vector::zeros());
+        s.penetration.clear();
+        s.penetration.resize(n, 0.0);
+        for b in &mut self.bodies {
+            if let Some(r) = b.rigid_mut() {
+                r.contact_force_n_m = Vector::zeros();
+                r.contact_torque_n = 0.0;
+            }
+        }
+        let dx = self.settings.spacing_m;
+        for ci in 0..self.contacts.len() {
+            let c = &mut self.contacts[ci];
+            let p = &self.particles;
+            let nl = &self.nbrs;
+            let k = &self.kernel;
+            let (prim, sec) = (c.primary as u32, c.secondary as u32);
+            let (k_r, k_f, mu, zeta, model) = (
+                c.k_r,
+                c.k_f,
+                c.params.friction,
+                c.params.damping_ratio,
+                c.params.model,
+            );
+            let prim_fixed = matches!(
+                self.bodies[c.primary].rigid().map(|r| r.motion),
+                Some(Motion::Fixed)
+            );
+            let sec_fixed = matches!(
+                self.bodies[c.secondary].rigid().map(|r| r.motion),
+                Some(Motion::Fixed)
+            );
+            let hits: Vec<Option<(Vector, usize, f64, f64, f64)>> = c
+                .spring
+                .par_iter_mut()
+                .zip(c.penetration.par_iter_mut())
+                .enumerate()
+                .map(|(i, (dl, pen_prev))| {
+                    if p.body[i] != sec {
+                        return None;
+                    }
+                    let js = nl
+                        .of(i)
+                        .iter()
+                        .map(|&j| j as usize)
+                        .filter(|&j| p.body[j] == prim);
+                    let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| {
+                        p.mass[j] / p.rho[j]
+                    });
+                    let det = match det {
+                        Some(d) if d.penetration > 0.0 => d,
+                        _ => {
+                            *dl = Vector::zeros();
+                            *pen_prev = 0.0;
+                            return None;
+                        }
+                    };
+                    let pen_rate = (det.penetration - *pen_prev) / dt;
+                    *pen_prev = det.penetration;
+                    let j = det.nearest;
+                    let vrel = p.vel[i] - p.vel[j];
+                    let fr = det.repulsion;
+                    let m_eff = match (sec_fixed, prim_fixed) {
+                        (true, _) => p.mass[j],
+                        (_, true) => p.mass[i],
+                        _ => p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]),
+                    };
+                    let c_t = 2.0 * zeta * (k_f * m_eff).sqrt();
+                    let ff = contact::friction(dl, vrel, det.normal, dt, k_f, c_t, mu, fr.norm());
+                    let cdamp = 2.0 * zeta * (k_r * m_eff).sqrt();
+                    let fd = det.normal * (cdamp * pen_rate);
+                    let work = -fd.norm() * pen_rate.abs() * dt;
+                    Some((fr + ff + fd, j, det.penetration, det.distance, work))
+                })
+                .collect();
+            // Sequential gather: eq. 29 reactions and eq. 17 sums in particle order.
+            let s = &mut self.scratch;
+            let mut damp = 0.0;
+            let mut through = None;
+            for (i, h) in hits.into_iter().enumerate() {
+                let Some((f, j, pen, dist, work)) = h else {
+                    continue;
+                };
+                s.contact_force[i] += f;
+                s.contact_force[j] -= f;
+                s.penetration[i] = pen;
+                damp += work;
+                if dist < 0.0 && through.is_none() {
+                    through = Some((i, dist));
+                }
+                let bj = &mut self.bodies[c.primary];
+                if let Some(r) = bj.rigid_mut() {
+                    r.contact_force_n_m -= f;
+                    r.contact_torque_n += cross(p.pos[j] - r.com_m, -f);
+                }
+                if let Some(r) = self.bodies[c.secondary].rigid_mut() {
+                    r.contact_force_n_m += f;
+                    r.contact_torque_n += cross(p.pos[i] - r.com_m, f);
+                }
+            }
+            self.work.contact_damping += damp;
+            if let Some((i, dist)) = through {
+                return Err(SimError {
+                    step: self.steps,
+                    time_s: self.time,
+                    what: format!(
+                        "particle {} of body '{}' passed through the surface of body '{}': distance {:.3e} m < 0",
+                        p.id[i], self.bodies[c.secondary].name, self.bodies[c.primary].name, dist
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Rigid-body motion from total force and torque (eq. 17), semi-implicit Euler.
+    fn rigid(&mut self, dt: f64) {
+        let g = self.settings.gravity_m_s2;
+        let t_next = self.time + dt;
+        for b in &mut self.bodies {
+            let Some(r) = b.rigid_mut() else { continue };
+            match r.motion.velocity(t_next) {
+                None => {
+                    let f = r.contact_force_n_m + r.external.at(self.time) + g * r.mass_kg_m;
+                    r.velocity_m_s += f * (dt / r.mass_kg_m);
+                    r.omega_rad_s += r.contact_torque_n * dt / r.inertia_kg_m;
+                }
+                Some(v) => {
+                    r.velocity_m_s = v;
+                    r.omega_rad_s = 0.0;
+                }
+            }
+            r.com_m += r.velocity_m_s * dt;
+            r.angle_rad += r.omega_rad_s * dt;
+        }
+        let bodies = &self.bodies;
+        let p = &mut self.particles;
+        // Fixed bodies never move: skip their particles.
+        let moving: Vec<bool> = bodies
+            .iter()
+            .map(|b| b.rigid().is_some_and(|r| r.motion != Motion::Fixed))
+            .collect();
+        if !moving.iter().any(|&m| m) {
+            return;
+        }
+        p.pos
+            .par_iter_mut()
+            .zip(p.vel.par_iter_mut())
+            .zip(p.body.par_iter())
+            .zip(p.local.par_iter())
+            .for_each(|(((x, v), &b), l)| {
+                if !moving[b as usize] {
+                    return;
+                }
+                if let Some(r) = bodies[b as usize].rigid() {
+                    let rl = rotate(*l, r.angle_rad);
+                    *x = r.com_m + rl;
+                    *v = r.velocity_m_s + omega_cross(r.omega_rad_s, rl);
+                }
+            });
+    }
+
+    /// Integrates deformable particles (semi-implicit Euler) and runs the failure checks.
+    fn integrate(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
+        let t_next = self.time + dt;
+        let motions: Vec<Option<Vector>> = self
+            .bodies
+            .iter()
+            .map(|b| match &b.kind {
+                BodyKind::Deformable {
+                    boundary_motion, ..
+                } => boundary_motion.velocity(t_next),
+                _ => None,
+            })
+            .collect();
+        let h = self.kernel.h;
+        let acc = &self.scratch.acc;
+        let cf = &self.scratch.contact_force;
+        let p = &mut self.particles;
+        let bad: Option<(usize, String)> = p
+            .pos
+            .par_iter_mut()
+            .zip(p.vel.par_iter_mut())
+            .enumerate()
+            .map(|(i, (x, v))| {
+                let b = p.body[i] as usize;
+                if !bc[b].deformable {
+                    return None;
+                }
+                if p.flags[i] & KINEMATIC != 0 {
+                    *v = motions[b].unwrap_or_else(Vector::zeros);
+                } else {
+                    *v += (acc[i] + cf[i] / p.mass[i]) * dt;
+                }
+                let dxs = *v * dt;
+                *x += dxs;
+                if !(x.x.is_finite() && x.y.is_finite() && v.x.is_finite() && v.y.is_finite()) {
+                    return Some((i, "position or velocity is not finite".to_string()));
+                }
+                if !(p.sdev[i].iter().all(|s| s.is_finite()) && p.rho[i].is_finite()) {
+                    return Some((i, "stress or density is not finite".to_string()));
+                }
+                if p.rho[i] <= 0.0 {
+                    return Some((i, format!("density {:.4e} kg/m³ is not positive", p.rho[i])));
+                }
+                let step = dxs.norm();
+                if step > h {
+                    return Some((
+                        i,
+                        format!("moved {step:.3e} m in one step, more than h = {h:.3e} m"),
+                    ));
+                }
+                None
+            })
+            .find_first(|b| b.is_some())
+            .flatten();
+        if let Some((i, what)) = bad {
+            let p = &self.particles;
+            return Err(SimError {
+                step: self.steps,
+                time_s: self.time,
+                what: format!(
+                    "particle {} of body '{}' at ({:.4e}, {:.4e}) m: {what}",
+                    p.id[i], self.bodies[p.body[i] as usize].name, p.pos[i].x, p.pos[i].y
+                ),
+            });
+        }
+        for b in &self.bodies {
+            if let Some(r) = b.rigid() {
+                let ok = r
+                    .com_m
+                    .iter()
+                    .chain(r.velocity_m_s.iter())
+                    .all(|x| x.is_finite())
+                    && r.omega_rad_s.is_finite();
+                if !ok {
+                    return Err(SimError {
+                        step: self.steps,
+                        time_s: self.time,
+                        what: format!(
+                            "rigid body '{}': position or velocity is not finite",
+                            b.name
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Shepard density filter (eq. 12) every `shepard_interval` steps, deletion of particles with
+    /// D ≥ 1, and the next time step.
+    fn housekeeping(&mut self, bc: &[BodyConst]) -> Result<(), SimError> {
+        let every = self.settings.shepard_interval as u64;
+        if every > 0 && self.steps % every == 0 {
+            let before = self.energy().elastic;
+            self.shepard_filter(bc);
+            self.work.density_filter += self.energy().elastic - before;
+        }
+        let failed: Vec<bool> = self.particles.damage.iter().map(|&d| d >= 1.0).collect();
+        if failed.iter().any(|&f| f) {
+            for (i, &f) in failed.iter().enumerate() {
+                if f {
+                    let b = self.particles.body[i] as usize;
+                    self.bodies[b].removed_mass_kg_m += self.particles.mass[i];
+                    self.bodies[b].removed_particles += 1;
+                }
+            }
+            let keep: Vec<bool> = failed.iter().map(|f| !f).collect();
+            self.retain_particles(&keep);
+        }
+        self.dt = self.compute_dt();
+        Ok(())
+    }
+
+    /// ρ_i = Σ m_j W_ij / Σ V_j W_ij over the body, self included (eq. 12).
+    fn shepard_filter(&mut self, bc: &[BodyConst]) {
+        if !self.nbrs_valid || self.nbrs.start.len() != self.particles.len() + 1 {
+            self.rebuild_neighbours();
+        }
+        let p = &self.particles;
+        let nl = &self.nbrs;
+        let k = &self.kernel;
+        let w0 = k.w(0.0);
+        let rho: Vec<f64> = (0..p.len())
+            .into_par_iter()
+            .map(|i| {
+                let bi = p.body[i];
+                if !bc[bi as usize].deformable {
+                    return p.rho[i];
+                }
+                let (mut num, mut den) = (p.mass[i] * w0, p.mass[i] / p.rho[i] * w0);
+                for &j in nl.of(i) {
+                    let j = j as usize;
+                    if p.body[j] != bi {
+                        continue;
+                    }
+                    let w = k.w((p.pos[i] - p.pos[j]).norm());
+                    num += p.mass[j] * w;
+                    den += p.mass[j] / p.rho[j] * w;
+                }
+                num / den
+            })
+            .collect();
+        self.particles.rho = rho;
+    }
+}
+
+/// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a
+/// well-conditioned inverse (an isolated fragment), the uncorrected gradient is used instead.
+fn correction(m: Matrix) -> Matrix {
+    let tr = m.trace();
+    let det = m.determinant();
+    // Smallest eigenvalue of the symmetric part relative to the mean: a conditioning measure.
+    let disc = ((tr * 0.5).powi(2) - det).max(0.0).sqrt();
+    let lmin = tr * 0.5 - disc;
+    if tr > 0.0 && lmin > 0.05 * tr * 0.5 {
+        m.try_inverse().unwrap_or_else(Matrix::identity)
+    } else {
+        Matrix::identity()
+    }
+}
