@@ -7,7 +7,14 @@ fn main() {
         hourglass: a[3].parse().unwrap(),
         ..Default::default()
     };
-    let h = grit_sph::verification::elastic_impact::simulate(n, s).unwrap();
+    let t_end: Option<f64> = a.get(4).map(|x| x.parse().unwrap());
+    let h = match grit_sph::verification::elastic_impact::simulate_until(n, s, t_end) {
+        Ok(h) => h,
+        Err(e) => {
+            println!("{e}");
+            return;
+        }
+    };
     let lc = h.in_contact.iter().rposition(|&c| c).unwrap_or(0);
     println!(
         "peak {:.4} after {:.4} at contact end {:.4} hg {:.3e} filt {:.3e} steps {}",

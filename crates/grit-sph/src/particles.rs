@@ -65,32 +65,22 @@ impl Particles {
 
     /// Keeps the particles with `keep[i]`, preserving order (so loop order stays deterministic).
     pub fn retain(&mut self, keep: &[bool]) {
-        fn r<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
-            let mut k = 0;
-            for i in 0..v.len() {
-                if keep[i] {
-                    v[k] = v[i];
-                    k += 1;
-                }
-            }
-            v.truncate(k);
-        }
-        r(&mut self.id, keep);
-        r(&mut self.body, keep);
-        r(&mut self.flags, keep);
-        r(&mut self.pos, keep);
-        r(&mut self.vel, keep);
-        r(&mut self.mass, keep);
-        r(&mut self.rho, keep);
-        r(&mut self.rho0, keep);
-        r(&mut self.sdev, keep);
-        r(&mut self.eps_p, keep);
-        r(&mut self.eps_p_rate, keep);
-        r(&mut self.temp, keep);
-        r(&mut self.damage, keep);
-        r(&mut self.def_grad, keep);
-        r(&mut self.x_ref, keep);
-        r(&mut self.local, keep);
+        retain_by(&mut self.id, keep);
+        retain_by(&mut self.body, keep);
+        retain_by(&mut self.flags, keep);
+        retain_by(&mut self.pos, keep);
+        retain_by(&mut self.vel, keep);
+        retain_by(&mut self.mass, keep);
+        retain_by(&mut self.rho, keep);
+        retain_by(&mut self.rho0, keep);
+        retain_by(&mut self.sdev, keep);
+        retain_by(&mut self.eps_p, keep);
+        retain_by(&mut self.eps_p_rate, keep);
+        retain_by(&mut self.temp, keep);
+        retain_by(&mut self.damage, keep);
+        retain_by(&mut self.def_grad, keep);
+        retain_by(&mut self.x_ref, keep);
+        retain_by(&mut self.local, keep);
     }
 }
 
@@ -105,4 +95,16 @@ pub fn von_mises(s: &Matrix) -> f64 {
 pub fn dev_contract(s: &Matrix) -> f64 {
     let szz = -(s[(0, 0)] + s[(1, 1)]);
     s[(0, 0)] * s[(0, 0)] + s[(1, 1)] * s[(1, 1)] + szz * szz + 2.0 * s[(0, 1)] * s[(0, 1)]
+}
+
+/// Keeps `v[i]` where `keep[i]`, in order: the one compaction every per-particle array uses.
+pub fn retain_by<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut k = 0;
+    for (i, &kp) in keep.iter().enumerate().take(v.len()) {
+        if kp {
+            v[k] = v[i];
+            k += 1;
+        }
+    }
+    v.truncate(k);
 }

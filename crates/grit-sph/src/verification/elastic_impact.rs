@@ -69,15 +69,24 @@ pub fn scene(n: usize, settings: Settings) -> World {
     w
 }
 
-/// Runs until the disc has left the block and travelled a further radius, or `t_max`.
+/// Runs until the disc has left the block and travelled two further radii.
 pub fn simulate(n: usize, settings: Settings) -> Result<History, SimError> {
+    simulate_until(n, settings, None)
+}
+
+/// Runs to `t_end` (s) if given, else until the disc has left and travelled two radii.
+pub fn simulate_until(
+    n: usize,
+    settings: Settings,
+    t_end: Option<f64>,
+) -> Result<History, SimError> {
     let mut w = scene(n, settings);
     let e0 = w.energy().total();
     let p0 = w.momentum();
     let mut h = History::default();
     let mut touched = false;
     let mut left_at = None;
-    let t_max = 40.0 * RADIUS / SPEED;
+    let t_max = t_end.unwrap_or(40.0 * RADIUS / SPEED);
     while w.time() < t_max {
         w.step()?;
         let touching = w.contact_forces().iter().any(|f| f.norm() > 0.0);
@@ -85,14 +94,14 @@ pub fn simulate(n: usize, settings: Settings) -> Result<History, SimError> {
         if touched && !touching && left_at.is_none() {
             left_at = Some(w.time());
         }
-        if w.steps() % 10 == 0 {
+        if w.steps().is_multiple_of(10) {
             h.t.push(w.time());
             h.energy.push(w.energy().total() / e0);
             h.momentum_drift
                 .push((w.momentum() - p0).norm() / p0.norm());
             h.in_contact.push(touching);
         }
-        if let Some(t) = left_at {
+        if let (Some(t), None) = (left_at, t_end) {
             if w.time() > t + 2.0 * RADIUS / SPEED {
                 break;
             }

@@ -1,0 +1,95 @@
+//! Charts drawn with plotters: simulation curves solid, analytic references dashed.
+
+use std::path::Path;
+
+use anyhow::anyhow;
+use grit_sph::verification::Chart;
+use plotters::prelude::*;
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+/// Writes `chart` as an SVG line chart with labelled axes and a legend.
+pub fn line_chart(chart: &Chart, path: &Path) -> anyhow::Result<()> {
+    let pts = chart
+        .series
+        .iter()
+        .flat_map(|s| s.x.iter().zip(&s.y))
+        .filter(|(x, y)| x.is_finite() && y.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in pts {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    if x0 > x1 {
+        return Err(anyhow!("chart {} has no finite points", chart.name));
+    }
+    let pad = |a: f64, b: f64| {
+        if b > a {
+            0.05 * (b - a)
+        } else {
+            1e-9_f64.max(a.abs() * 0.05)
+        }
+    };
+    let (px, py) = (pad(x0, x1), pad(y0, y1));
+    let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+    let mut ctx = ChartBuilder::on(&root)
+        .caption(&chart.title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0 - px)..(x1 + px), (y0 - py)..(y1 + py))
+        .map_err(|e| anyhow!("{e}"))?;
+    ctx.configure_mesh()
+        .x_desc(&chart.x_label)
+        .y_desc(&chart.y_label)
+        .draw()
+        .map_err(|e| anyhow!("{e}"))?;
+    let mut colour = 0;
+    for s in &chart.series {
+        // A reference takes the colour of the simulation drawn just before it.
+        let c = if s.reference && colour > 0 {
+            PALETTE[(colour - 1) % PALETTE.len()]
+        } else {
+            PALETTE[colour % PALETTE.len()]
+        };
+        let data: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
+        if s.reference {
+            let style = ShapeStyle {
+                color: c.mix(0.9),
+                filled: false,
+                stroke_width: 1,
+            };
+            ctx.draw_series(DashedLineSeries::new(data, 6, 4, style))
+                .map_err(|e| anyhow!("{e}"))?
+                .label(&s.label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+        } else {
+            ctx.draw_series(LineSeries::new(data, c.stroke_width(2)))
+                .map_err(|e| anyhow!("{e}"))?
+                .label(&s.label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+            colour += 1;
+        }
+    }
+    ctx.configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| anyhow!("{e}"))?;
+    root.present().map_err(|e| anyhow!("{e}"))?;
+    Ok(())
+}

@@ -1,0 +1,87 @@
+//! `grit verify`: the seed's contact benchmarks and the engine's own checks, as a table.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use grit_sph::verification::{elastic_impact, hourglass, sliding, slope, CaseReport};
+
+/// A verification case run at the chosen resolution.
+type Case = Box<dyn Fn() -> Result<CaseReport, grit_sph::SimError>>;
+
+/// Arguments of `grit verify`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Run the CI resolutions only (the ones the tests use).
+    #[arg(long)]
+    quick: bool,
+    /// Print the table as a JSON array of {case, resolution, value, reference, error_rel, pass}.
+    #[arg(long)]
+    json: bool,
+    /// Write one SVG chart per case into this folder.
+    #[arg(long)]
+    charts: Option<PathBuf>,
+    /// Run only the cases whose name contains this text (slope, sliding, impact, hourglass).
+    #[arg(long)]
+    only: Option<String>,
+}
+
+/// Runs the cases; exits 1 if any row fails its tolerance.
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let (slope_n, slide_n, impact_n, hg_n) = if a.quick {
+        (20, 20, 20, 20)
+    } else {
+        (40, 40, 60, 40)
+    };
+    let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
+    let mut rep = CaseReport::default();
+    let cases: [(&str, Case); 4] = [
+        ("slope", Box::new(move || slope::run(slope_n))),
+        ("sliding", Box::new(move || sliding::run(slide_n))),
+        ("impact", Box::new(move || elastic_impact::run(impact_n))),
+        ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
+    ];
+    for (name, f) in cases.iter() {
+        if !want(name) {
+            continue;
+        }
+        eprintln!("running {name} ...");
+        rep.extend(f().with_context(|| format!("case {name}"))?);
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&rep.rows)?);
+    } else {
+        println!(
+            "{:<42} {:<40} {:>12} {:>12} {:>10} {:>5}",
+            "case", "resolution", "value", "reference", "error", "pass"
+        );
+        for r in &rep.rows {
+            println!(
+                "{:<42} {:<40} {:>12.5e} {:>12.5e} {:>10.3e} {:>5}",
+                r.case,
+                r.resolution,
+                r.value,
+                r.reference,
+                r.error_rel,
+                if r.pass { "yes" } else { "NO" }
+            );
+        }
+        println!();
+        for r in &rep.rows {
+            println!("{}: {}", r.case, r.note);
+        }
+    }
+    if let Some(dir) = &a.charts {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for c in &rep.charts {
+            let path = dir.join(format!("{}.svg", c.name));
+            crate::charts::line_chart(c, &path)?;
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(if rep.rows.iter().all(|r| r.pass) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
