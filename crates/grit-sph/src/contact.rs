@@ -67,6 +67,16 @@ pub struct ContactPair {
     pub spring: Vec<Vector>,
     /// Penetration of the previous step per particle (0 while out of contact), for the dashpot.
     pub penetration: Vec<f64>,
+    /// Smallest mass of a particle the springs act on (kg/m), for the contact time step.
+    pub min_mass: f64,
+}
+
+impl ContactPair {
+    /// Whether a particle of body `body` with `flags` carries this pair's springs: any particle
+    /// of the secondary, boundary particles of the primary.
+    pub fn touches(&self, body: usize, flags: u8) -> bool {
+        body == self.secondary || (body == self.primary && flags & crate::particles::BOUNDARY != 0)
+    }
 }
 
 /// Geometry of one secondary particle relative to the primary surface.

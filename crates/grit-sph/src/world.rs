@@ -153,9 +153,9 @@ struct BodyConst {
     sound: f64,
 }
 
-/// One secondary particle's contact: (force on it, nearest primary particle, penetration,
-/// distance, dashpot work).
-type Hit = (Vector, usize, f64, f64, f64);
+/// One secondary particle's contact: (force on it, nearest primary particle, distance,
+/// dashpot work).
+type Hit = (Vector, usize, f64, f64);
 
 /// Scratch arrays rebuilt every step (not part of a checkpoint).
 #[derive(Debug, Clone, Default)]
@@ -165,7 +165,6 @@ struct Scratch {
     gradv: Vec<Matrix>,
     acc: Vec<Vector>,
     contact_force: Vec<Vector>,
-    penetration: Vec<f64>,
 }
 
 /// A 2D SPH scene: bodies, their particles, contact pairs, time.
@@ -314,6 +313,9 @@ impl World {
         for c in &mut self.contacts {
             c.spring.push(Vector::zeros());
             c.penetration.push(0.0);
+            if c.touches(body, flags) {
+                c.min_mass = c.min_mass.min(mass);
+            }
         }
         self.nbrs_valid = false;
     }
@@ -543,7 +545,9 @@ impl World {
             k_f,
             spring: vec![Vector::zeros(); self.particles.len()],
             penetration: vec![0.0; self.particles.len()],
+            min_mass: f64::INFINITY,
         });
+        self.refresh_contact_masses();
         self.nbrs_valid = false;
         Ok(self.contacts.len() - 1)
     }
@@ -591,10 +595,9 @@ impl World {
             }
         }
         for c in &self.contacts {
-            for i in 0..p.len().min(self.scratch.penetration.len()) {
-                if p.body[i] as usize == c.secondary && self.scratch.penetration[i] > 0.0 {
-                    e.contact += 0.5 * c.k_r * self.scratch.penetration[i].powi(2)
-                        + 0.5 * c.spring[i].norm_squared() * c.k_f;
+            for (i, &pen) in c.penetration.iter().enumerate() {
+                if pen > 0.0 {
+                    e.contact += 0.5 * c.k_r * pen * pen + 0.5 * c.spring[i].norm_squared() * c.k_f;
                 }
             }
         }
@@ -648,7 +651,20 @@ impl World {
             crate::particles::retain_by(&mut c.spring, keep);
             crate::particles::retain_by(&mut c.penetration, keep);
         }
+        self.refresh_contact_masses();
         self.nbrs_valid = false;
+    }
+
+    /// Smallest particle mass each contact's springs act on, for the contact time step; kept
+    /// here so the step does not scan every particle for it.
+    fn refresh_contact_masses(&mut self) {
+        let p = &self.particles;
+        for c in &mut self.contacts {
+            c.min_mass = (0..p.len())
+                .filter(|&i| c.touches(p.body[i] as usize, p.flags[i]))
+                .map(|i| p.mass[i])
+                .fold(f64::INFINITY, f64::min);
+        }
     }
 
     /// Rebuilds neighbour lists: deformable particles see their own body and the primary
@@ -723,15 +739,8 @@ impl World {
             dt = dt.min(self.settings.cfl * h / smax);
         }
         for c in &self.contacts {
-            let m_min = (0..p.len())
-                .filter(|&i| {
-                    let b = p.body[i] as usize;
-                    b == c.secondary || (b == c.primary && p.flags[i] & BOUNDARY != 0)
-                })
-                .map(|i| p.mass[i])
-                .fold(f64::INFINITY, f64::min);
-            if m_min.is_finite() {
-                dt = dt.min(self.settings.cfl * (m_min / (c.k_r + c.k_f)).sqrt() * 2.0);
+            if c.min_mass.is_finite() {
+                dt = dt.min(self.settings.cfl * (c.min_mass / (c.k_r + c.k_f)).sqrt() * 2.0);
             }
         }
         dt
@@ -797,17 +806,9 @@ impl World {
                 if !bc[bi as usize].deformable {
                     return (1.0, Matrix::identity());
                 }
-                let xi = p.pos[i];
                 let mut g = p.mass[i] / p.rho[i] * w0;
                 let mut m = Matrix::zeros();
-                for &j in nl.of(i) {
-                    let j = j as usize;
-                    if p.body[j] != bi {
-                        continue;
-                    }
-                    let xij = xi - p.pos[j];
-                    let r = xij.norm();
-                    let (w, dw) = k.w_dw(r);
+                for Pair { j, xij, r, w, dw } in body_pairs(p, nl, k, i) {
                     let vj = p.mass[j] / p.rho[j];
                     g += vj * w;
                     if r > 0.0 {
@@ -841,20 +842,12 @@ impl World {
                 if !bc[bi as usize].deformable {
                     return Matrix::zeros();
                 }
-                let xi = p.pos[i];
                 let vi = p.vel[i];
                 let mut gv = Matrix::zeros();
-                for &j in nl.of(i) {
-                    let j = j as usize;
-                    if p.body[j] != bi {
-                        continue;
-                    }
-                    let xij = xi - p.pos[j];
-                    let r = xij.norm();
+                for Pair { j, xij, r, dw, .. } in body_pairs(p, nl, k, i) {
                     if r == 0.0 {
                         continue;
                     }
-                    let (_, dw) = k.w_dw(r);
                     let vj = p.mass[j] / p.rho[j];
                     gv += outer(p.vel[j] - vi, xij * (dw / r)) * vj;
                 }
@@ -971,22 +964,14 @@ impl World {
                 if !c.deformable {
                     return (Vector::zeros(), 0.0);
                 }
-                let xi = p.pos[i];
                 let vi = p.vel[i];
                 let voli = p.mass[i] / p.rho[i];
                 let mut a = Vector::zeros();
                 let mut fhg = Vector::zeros();
-                for &j in nl.of(i) {
-                    let j = j as usize;
-                    if p.body[j] != bi {
-                        continue;
-                    }
-                    let xij = xi - p.pos[j];
-                    let r = xij.norm();
+                for Pair { j, xij, r, w, dw } in body_pairs(p, nl, k, i) {
                     if r == 0.0 {
                         continue;
                     }
-                    let (w, dw) = k.w_dw(r);
                     let grad = xij * (dw / r);
                     a += (sig[i] + sig[j]) * grad * p.mass[j];
                     if alpha > 0.0 && w > 0.0 {
@@ -1029,8 +1014,6 @@ impl World {
         let s = &mut self.scratch;
         s.contact_force.clear();
         s.contact_force.resize(n, Vector::zeros());
-        s.penetration.clear();
-        s.penetration.resize(n, 0.0);
         for b in &mut self.bodies {
             if let Some(r) = b.rigid_mut() {
                 r.contact_force_n_m = Vector::zeros();
@@ -1100,7 +1083,7 @@ impl World {
                     let cdamp = 2.0 * zeta * (k_r * m_eff).sqrt();
                     let fd = det.normal * (cdamp * pen_rate);
                     let work = -fd.norm() * pen_rate.abs() * dt;
-                    Some((fr + ff + fd, j, det.penetration, det.distance, work))
+                    Some((fr + ff + fd, j, det.distance, work))
                 })
                 .collect();
             // Sequential gather: eq. 29 reactions and eq. 17 sums in particle order.
@@ -1108,12 +1091,11 @@ impl World {
             let mut damp = 0.0;
             let mut through = None;
             for (i, h) in hits.into_iter().enumerate() {
-                let Some((f, j, pen, dist, work)) = h else {
+                let Some((f, j, dist, work)) = h else {
                     continue;
                 };
                 s.contact_force[i] += f;
                 s.contact_force[j] -= f;
-                s.penetration[i] = pen;
                 damp += work;
                 if dist < 0.0 && through.is_none() {
                     through = Some((i, dist));
@@ -1323,12 +1305,7 @@ impl World {
                     return p.rho[i];
                 }
                 let (mut num, mut den) = (p.mass[i] * w0, p.mass[i] / p.rho[i] * w0);
-                for &j in nl.of(i) {
-                    let j = j as usize;
-                    if p.body[j] != bi {
-                        continue;
-                    }
-                    let w = k.w((p.pos[i] - p.pos[j]).norm());
+                for Pair { j, w, .. } in body_pairs(p, nl, k, i) {
                     num += p.mass[j] * w;
                     den += p.mass[j] / p.rho[j] * w;
                 }
@@ -1337,6 +1314,36 @@ impl World {
             .collect();
         self.particles.rho = rho;
     }
+}
+
+/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr.
+struct Pair {
+    j: usize,
+    xij: Vector,
+    r: f64,
+    w: f64,
+    dw: f64,
+}
+
+/// The same-body neighbours of `i` with their kernel values: the loop every SPH sum of the
+/// deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
+fn body_pairs<'a>(
+    p: &'a Particles,
+    nl: &'a NeighbourLists,
+    k: &'a Kernel,
+    i: usize,
+) -> impl Iterator<Item = Pair> + 'a {
+    let (bi, xi) = (p.body[i], p.pos[i]);
+    nl.of(i)
+        .iter()
+        .map(|&j| j as usize)
+        .filter(move |&j| p.body[j] == bi)
+        .map(move |j| {
+            let xij = xi - p.pos[j];
+            let r = xij.norm();
+            let (w, dw) = k.w_dw(r);
+            Pair { j, xij, r, w, dw }
+        })
 }
 
 /// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a

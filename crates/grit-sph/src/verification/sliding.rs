@@ -3,8 +3,8 @@
 //! then accelerates ever faster until 1 s and at a constant rate after (NOTES.md).
 
 use super::{CaseReport, Chart, Row, Series};
-use crate::body::{ExternalForce, Motion};
-use crate::contact::{ContactModel, ContactParams};
+use crate::body::ExternalForce;
+use crate::contact::ContactModel;
 use crate::error::SimError;
 use crate::geometry::Polygon;
 use crate::math::Vector;
@@ -54,21 +54,16 @@ pub fn simulate(n_side: usize, sample_dt: f64) -> Result<Vec<(f64, f64)>, SimErr
     let travel = analytic_speed(DURATION) * DURATION + 2.0 * SIDE;
     let floor = Polygon::rectangle(-SIDE, -3.0 * dx, travel + SIDE, 0.0);
     let slider = Polygon::rectangle(0.0, 0.0, SIDE, SIDE);
-    let floor_b = w
-        .add_rigid("floor", &floor, RHO, Vector::zeros(), 0.0, Motion::Fixed)
-        .expect("floor");
-    let slider_b = w
-        .add_rigid("slider", &slider, RHO, Vector::zeros(), 0.0, Motion::Free)
-        .expect("slider");
-    let k = FN / (n_side as f64 * super::slope::OVERLAP * dx);
-    let params = ContactParams {
-        model: ContactModel::Extrapolated,
-        friction: MU,
-        normal_stiffness_pa: Some(k),
-        tangential_stiffness_pa: Some(super::slope::TANGENTIAL_OVER_NORMAL * k),
-        damping_ratio: 0.5,
-    };
-    w.add_contact(slider_b, floor_b, params).expect("contact");
+    let (_, slider_b, _) = super::slope::slider_on_floor(
+        &mut w,
+        &floor,
+        &slider,
+        RHO,
+        FN,
+        n_side,
+        ContactModel::Extrapolated,
+        MU,
+    );
     let force = ExternalForce {
         constant_n_m: Vector::new(0.0, -FN),
         ramp_n_m: Vector::new(0.8 * FN, 0.0),
@@ -77,20 +72,7 @@ pub fn simulate(n_side: usize, sample_dt: f64) -> Result<Vec<(f64, f64)>, SimErr
     };
     w.set_external_force(slider_b, force).expect("rigid");
     w.run_until(SETTLE_S, |_| false)?;
-    let t0 = w.time();
-    let mut out = vec![(0.0, 0.0)];
-    let mut next = sample_dt;
-    while w.time() - t0 < DURATION - 1e-12 {
-        w.step()?;
-        if w.time() - t0 >= next - 1e-12 {
-            out.push((
-                w.time() - t0,
-                w.bodies()[slider_b].rigid().expect("rigid").velocity_m_s.x,
-            ));
-            next += sample_dt;
-        }
-    }
-    Ok(out)
+    super::slope::release_and_sample(&mut w, slider_b, Vector::new(1.0, 0.0), DURATION, sample_dt)
 }
 
 /// (onset time, worst relative speed error from 0.75 s on, worst absolute error after onset).

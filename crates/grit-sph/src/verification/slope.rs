@@ -29,6 +29,44 @@ pub fn analytic_speed(mu: f64, t: f64) -> f64 {
     ((THETA.sin() - mu * THETA.cos()) * G * t).max(0.0)
 }
 
+/// Adds a fixed rigid `floor` and a free rigid `slider` resting on it, in contact with springs
+/// whose static overlap is OVERLAP·Δx when ~`n_side` of them carry `load_n_m` normal to the
+/// floor; returns (floor, slider, contact pair). Shared by the slope and controlled-sliding cases.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn slider_on_floor(
+    w: &mut World,
+    floor: &Polygon,
+    slider: &Polygon,
+    rho: f64,
+    load_n_m: f64,
+    n_side: usize,
+    model: ContactModel,
+    mu: f64,
+) -> (usize, usize, usize) {
+    let dx = w.settings().spacing_m;
+    let floor_b = w
+        .add_rigid("floor", floor, rho, Vector::zeros(), 0.0, Motion::Fixed)
+        .expect("floor");
+    let slider_b = w
+        .add_rigid("slider", slider, rho, Vector::zeros(), 0.0, Motion::Free)
+        .expect("slider");
+    // Stiffer springs make the slider chatter on its corners, softer ones let it lean onto its
+    // leading corner, where the smoothed normal tilts.
+    let k = load_n_m / (n_side as f64 * OVERLAP * dx);
+    let params = ContactParams {
+        model,
+        friction: mu,
+        normal_stiffness_pa: Some(k),
+        // A soft friction spring lets the slider slip by μ f_r / k_f before friction engages and
+        // keeps the speed it gained then: sqrt(μN (2F − μN) / (M K)). Stiffer k_f shrinks it.
+        tangential_stiffness_pa: Some(TANGENTIAL_OVER_NORMAL * k),
+        // Without it the slider rocks on its undamped springs for the whole run.
+        damping_ratio: 0.5,
+    };
+    let ci = w.add_contact(slider_b, floor_b, params).expect("contact");
+    (floor_b, slider_b, ci)
+}
+
 /// Simulated (t, speed along slope) samples every `sample_dt` for one μ and contact model, with
 /// `n_side` particles along the slider side.
 pub fn simulate(
@@ -54,27 +92,8 @@ pub fn simulate(
         Polygon::rectangle(-2.0 * SIDE, -3.0 * dx, travel, 0.0).rotated(-THETA, Vector::zeros());
     let slider = Polygon::rectangle(0.0, 0.0, SIDE, SIDE).rotated(-THETA, Vector::zeros());
     let rho = 1000.0;
-    let slope_b = w
-        .add_rigid("slope", &slope, rho, Vector::zeros(), 0.0, Motion::Fixed)
-        .expect("slope");
-    let slider_b = w
-        .add_rigid("slider", &slider, rho, Vector::zeros(), 0.0, Motion::Free)
-        .expect("slider");
-    let weight = rho * SIDE * SIDE * G;
-    // Static overlap OVERLAP·Δx with ~n_side springs carrying the weight: stiffer springs make
-    // the slider chatter on its corners, softer ones let it lean onto its leading corner.
-    let k = weight * THETA.cos() / (n_side as f64 * OVERLAP * dx);
-    let params = ContactParams {
-        model,
-        friction: mu,
-        normal_stiffness_pa: Some(k),
-        // A soft friction spring lets the slider slip by μ f_r / k_f before friction engages and
-        // keeps the speed it gained then: sqrt(μN (2F − μN) / (M K)). Stiffer k_f shrinks it.
-        tangential_stiffness_pa: Some(TANGENTIAL_OVER_NORMAL * k),
-        // Without it the slider rocks on its undamped springs for the whole run.
-        damping_ratio: 0.5,
-    };
-    let ci = w.add_contact(slider_b, slope_b, params).expect("contact");
+    let load = rho * SIDE * SIDE * G * THETA.cos();
+    let (_, slider_b, ci) = slider_on_floor(&mut w, &slope, &slider, rho, load, n_side, model, mu);
     // Settle first with friction that holds the slider (μ = 1 > tan θ), then lower μ at t0: the
     // slider starts at rest on loaded, tilted springs, as the seed's analytic solution assumes,
     // instead of falling onto unloaded ones and carrying the transient into the speed curve.
@@ -86,14 +105,26 @@ pub fn simulate(
         r.velocity_m_s = Vector::zeros();
         r.omega_rad_s = 0.0;
     }
+    release_and_sample(&mut w, slider_b, s, DURATION, sample_dt)
+}
+
+/// Steps for `duration` (s) from now, sampling the slider's speed along `dir` every `sample_dt`, with
+/// time counted from now: the clock of the analytic solutions starts at the release.
+pub(super) fn release_and_sample(
+    w: &mut World,
+    slider_b: usize,
+    dir: Vector,
+    duration: f64,
+    sample_dt: f64,
+) -> Result<Vec<(f64, f64)>, SimError> {
     let t0 = w.time();
     let mut out = vec![(0.0, 0.0)];
     let mut next = sample_dt;
-    while w.time() - t0 < DURATION - 1e-12 {
+    while w.time() - t0 < duration - 1e-12 {
         w.step()?;
         if w.time() - t0 >= next - 1e-12 {
             let v = w.bodies()[slider_b].rigid().expect("rigid").velocity_m_s;
-            out.push((w.time() - t0, v.dot(&s)));
+            out.push((w.time() - t0, v.dot(&dir)));
             next += sample_dt;
         }
     }
