@@ -2,6 +2,7 @@
 //! parses arguments and dispatches.
 
 mod charts;
+mod sample_cli;
 mod verify;
 
 use clap::{Parser, Subcommand};
@@ -18,12 +19,18 @@ struct Cli {
 enum Command {
     /// Run the engine's verification cases and print case, resolution, value, reference, error.
     Verify(verify::Args),
+    /// Print the built-in grain shapes with angularity and aspect ratio (seed Table 2).
+    Shapes(sample_cli::ShapesArgs),
+    /// Run one sample (N sequential random impacts on a fresh surface) locally.
+    Sample(sample_cli::SampleArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Verify(a) => verify::run(a),
+        Command::Shapes(a) => sample_cli::shapes(a),
+        Command::Sample(a) => sample_cli::sample(a),
     };
     match result {
         Ok(code) => code,

@@ -5,6 +5,8 @@
 
 pub mod aggregate;
 pub mod fits;
+pub mod impact;
+pub mod sample;
 pub mod shapes;
 
 pub use aggregate::{
@@ -16,3 +18,5 @@ pub use fits::{
     ShapeReference, AISI304_HV_GPA,
 };
 pub use shapes::{Shape, ShapeError, ShapeInfo};
+pub use impact::{ImpactError, ImpactOutcome, ImpactParams};
+pub use sample::{ImpactRecord, Sample, SampleError};

@@ -25,6 +25,7 @@ pub use contact::{ContactModel, ContactParams};
 pub use geometry::Polygon;
 pub use kernel::{Kernel, KernelKind};
 pub use math::{Matrix, Vector};
+pub use particles::Particles;
 pub use timers::{Stage, Timers};
 pub use world::{Energy, NumericalWork, Settings, World};
 pub mod verification;

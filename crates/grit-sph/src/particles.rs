@@ -82,6 +82,57 @@ impl Particles {
         retain_by(&mut self.x_ref, keep);
         retain_by(&mut self.local, keep);
     }
+
+    /// A copy of the particles with `keep[i]`, in order (a body's state, for a checkpoint).
+    pub fn select(&self, keep: &[bool]) -> Particles {
+        let mut out = self.clone();
+        out.retain(keep);
+        out
+    }
+
+    /// Appends `other`'s particles after these, unchanged.
+    pub fn append(&mut self, mut other: Particles) {
+        self.id.append(&mut other.id);
+        self.body.append(&mut other.body);
+        self.flags.append(&mut other.flags);
+        self.pos.append(&mut other.pos);
+        self.vel.append(&mut other.vel);
+        self.mass.append(&mut other.mass);
+        self.rho.append(&mut other.rho);
+        self.rho0.append(&mut other.rho0);
+        self.sdev.append(&mut other.sdev);
+        self.eps_p.append(&mut other.eps_p);
+        self.eps_p_rate.append(&mut other.eps_p_rate);
+        self.temp.append(&mut other.temp);
+        self.damage.append(&mut other.damage);
+        self.def_grad.append(&mut other.def_grad);
+        self.x_ref.append(&mut other.x_ref);
+        self.local.append(&mut other.local);
+    }
+
+    /// True when every per-particle array has the same length (a decoded checkpoint, say).
+    pub fn is_consistent(&self) -> bool {
+        let n = self.id.len();
+        [
+            self.body.len(),
+            self.flags.len(),
+            self.pos.len(),
+            self.vel.len(),
+            self.mass.len(),
+            self.rho.len(),
+            self.rho0.len(),
+            self.sdev.len(),
+            self.eps_p.len(),
+            self.eps_p_rate.len(),
+            self.temp.len(),
+            self.damage.len(),
+            self.def_grad.len(),
+            self.x_ref.len(),
+            self.local.len(),
+        ]
+        .iter()
+        .all(|&l| l == n)
+    }
 }
 
 /// Von Mises equivalent stress of a plane-strain deviator: sqrt(3/2 s:s) with s_zz = −(s_xx + s_yy).

@@ -160,6 +160,11 @@ type Hit = (Vector, usize, f64, f64);
 /// Scratch arrays rebuilt every step (not part of a checkpoint).
 #[derive(Debug, Clone, Default)]
 struct Scratch {
+    /// Same-body pairs of this step with their kernel values, in each particle's slice of the
+    /// neighbour rows (first `pair_count[i]` entries used): computed once in the kernel sums,
+    /// read by the rates and the forces, so each pair's kernel is evaluated once per step.
+    pairs: Vec<Pair>,
+    pair_count: Vec<u32>,
     shepard: Vec<f64>,
     lcorr: Vec<Matrix>,
     gradv: Vec<Matrix>,
@@ -379,6 +384,73 @@ impl World {
         let pts = polygon.fill_lattice(dx, lattice_origin);
         let vols = vec![dx * dx; pts.len()];
         self.add_deformable(name, material, &pts, &vols, velocity_m_s)
+    }
+
+    /// Adds a deformable body from a saved particle state (`body_state` of an earlier world):
+    /// stress, strain, damage and flags carry over unchanged, so a sample can go on from one
+    /// impact to the next in a fresh world (seed section 4).
+    pub fn add_deformable_state(
+        &mut self,
+        name: &str,
+        material: Material,
+        mut state: Particles,
+        boundary_motion: Motion,
+    ) -> Result<usize, InputError> {
+        material.validate()?;
+        if state.is_empty() || !state.is_consistent() {
+            return Err(InputError::new(
+                format!("{name}.state"),
+                "needs at least one particle and equal lengths of every per-particle array",
+            ));
+        }
+        let finite = state
+            .pos
+            .iter()
+            .chain(&state.vel)
+            .all(|v| v.iter().all(|x| x.is_finite()))
+            && state
+                .mass
+                .iter()
+                .chain(&state.rho)
+                .all(|&x| x.is_finite() && x > 0.0);
+        if !finite {
+            return Err(InputError::new(
+                format!("{name}.state"),
+                "positions and velocities must be finite, masses and densities > 0",
+            ));
+        }
+        let b = self.bodies.len();
+        self.bodies.push(Body {
+            name: name.to_string(),
+            kind: BodyKind::Deformable {
+                material,
+                boundary_motion,
+            },
+            removed_mass_kg_m: 0.0,
+            removed_particles: 0,
+        });
+        let n = state.len();
+        state.body.iter_mut().for_each(|x| *x = b as u32);
+        self.next_id = self.next_id.max(state.id.iter().max().map_or(0, |m| m + 1));
+        for c in &mut self.contacts {
+            c.spring.resize(self.particles.len() + n, Vector::zeros());
+            c.penetration.resize(self.particles.len() + n, 0.0);
+        }
+        self.particles.append(state);
+        self.refresh_contact_masses();
+        self.nbrs_valid = false;
+        Ok(b)
+    }
+
+    /// A copy of body `b`'s particles, in loop order (for `add_deformable_state`).
+    pub fn body_state(&self, b: usize) -> Particles {
+        let keep: Vec<bool> = self
+            .particles
+            .body
+            .iter()
+            .map(|&x| x as usize == b)
+            .collect();
+        self.particles.select(&keep)
     }
 
     /// Makes the particles of deformable body `b` that satisfy `select` kinematic: they move
@@ -798,33 +870,57 @@ impl World {
         let k = &self.kernel;
         let w0 = k.w(0.0);
         let n = p.len();
-        let out: Vec<(f64, Matrix)> = (0..n)
+        let mut buf = std::mem::take(&mut self.scratch.pairs);
+        // Rows are overwritten before they are read: grow, never clear (a memset per step).
+        if buf.len() < nl.list.len() {
+            buf.resize(nl.list.len(), Pair::default());
+        }
+        // One mutable slice per particle, so the rows fill in parallel, each by its own owner.
+        let mut rows: Vec<&mut [Pair]> = Vec::with_capacity(n);
+        let mut rest = buf.as_mut_slice();
+        for i in 0..n {
+            let (row, tail) = rest.split_at_mut(nl.of(i).len());
+            rows.push(row);
+            rest = tail;
+        }
+        let out: Vec<(f64, Matrix, u32)> = rows
             .into_par_iter()
             .with_min_len(MIN_LEN)
-            .map(|i| {
+            .enumerate()
+            .map(|(i, row)| {
                 let bi = p.body[i];
                 if !bc[bi as usize].deformable {
-                    return (1.0, Matrix::identity());
+                    return (1.0, Matrix::identity(), 0);
                 }
                 let mut g = p.mass[i] / p.rho[i] * w0;
                 let mut m = Matrix::zeros();
-                for Pair { j, xij, r, w, dw } in body_pairs(p, nl, k, i) {
-                    let vj = p.mass[j] / p.rho[j];
-                    g += vj * w;
-                    if r > 0.0 {
-                        let grad = xij * (dw / r);
-                        m += outer(-xij, grad) * vj;
+                let mut cnt = 0;
+                for pair in body_pairs(p, nl, k, i) {
+                    // Listed within the skin but outside the support: contributes nothing.
+                    if pair.w == 0.0 && pair.dw == 0.0 {
+                        continue;
                     }
+                    let vj = p.mass[pair.j] / p.rho[pair.j];
+                    g += vj * pair.w;
+                    if pair.r > 0.0 {
+                        let grad = pair.xij * (pair.dw / pair.r);
+                        m += outer(-pair.xij, grad) * vj;
+                    }
+                    row[cnt] = pair;
+                    cnt += 1;
                 }
-                (g, correction(m))
+                (g, correction(m), cnt as u32)
             })
             .collect();
         let s = &mut self.scratch;
+        s.pairs = buf;
         s.shepard.clear();
         s.lcorr.clear();
-        for (g, l) in out {
+        s.pair_count.clear();
+        for (g, l, c) in out {
             s.shepard.push(g);
             s.lcorr.push(l);
+            s.pair_count.push(c);
         }
     }
 
@@ -832,8 +928,8 @@ impl World {
     fn rates(&mut self, bc: &[BodyConst]) {
         let p = &self.particles;
         let nl = &self.nbrs;
-        let k = &self.kernel;
         let lc = &self.scratch.lcorr;
+        let pairs = &self.scratch;
         let out: Vec<Matrix> = (0..p.len())
             .into_par_iter()
             .with_min_len(MIN_LEN)
@@ -844,7 +940,7 @@ impl World {
                 }
                 let vi = p.vel[i];
                 let mut gv = Matrix::zeros();
-                for Pair { j, xij, r, dw, .. } in body_pairs(p, nl, k, i) {
+                for &Pair { j, xij, r, dw, .. } in pairs.cached(nl, i) {
                     if r == 0.0 {
                         continue;
                     }
@@ -942,6 +1038,7 @@ impl World {
         let radius = k.radius();
         let sh = &self.scratch.shepard;
         let gv = &self.scratch.gradv;
+        let cache = &self.scratch;
         // σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
         let sig: Vec<Matrix> = (0..p.len())
             .into_par_iter()
@@ -961,14 +1058,15 @@ impl World {
             .map(|i| {
                 let bi = p.body[i];
                 let c = bc[bi as usize];
-                if !c.deformable {
+                // Kinematic particles follow their prescribed motion: their force is never used.
+                if !c.deformable || p.flags[i] & KINEMATIC != 0 {
                     return (Vector::zeros(), 0.0);
                 }
                 let vi = p.vel[i];
                 let voli = p.mass[i] / p.rho[i];
                 let mut a = Vector::zeros();
                 let mut fhg = Vector::zeros();
-                for Pair { j, xij, r, w, dw } in body_pairs(p, nl, k, i) {
+                for &Pair { j, xij, r, w, dw } in cache.cached(nl, i) {
                     if r == 0.0 {
                         continue;
                     }
@@ -1316,7 +1414,17 @@ impl World {
     }
 }
 
+impl Scratch {
+    /// The cached same-body pairs of particle `i` (filled by the kernel sums this step).
+    #[inline]
+    fn cached<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [Pair] {
+        let s = nl.start[i] as usize;
+        &self.pairs[s..s + self.pair_count[i] as usize]
+    }
+}
+
 /// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr.
+#[derive(Debug, Clone, Copy, Default)]
 struct Pair {
     j: usize,
     xij: Vector,
