@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use grit_sph::verification::{elastic_impact, hourglass, sliding, slope, CaseReport};
+use grit_sph::verification::{elastic_impact, hertz, hourglass, sliding, slope, CaseReport};
 
 /// A verification case run at the chosen resolution.
 type Case = Box<dyn Fn() -> Result<CaseReport, grit_sph::SimError>>;
@@ -21,7 +21,8 @@ pub struct Args {
     /// Write one SVG chart per case into this folder.
     #[arg(long)]
     charts: Option<PathBuf>,
-    /// Run only the cases whose name contains this text (slope, sliding, impact, hourglass).
+    /// Run only the cases whose name contains this text (slope, sliding, hertz, impact,
+    /// hourglass).
     #[arg(long)]
     only: Option<String>,
 }
@@ -33,11 +34,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         (40, 40, 60, 40)
     };
+    // Particles per cylinder radius, coarse to fine: the convergence of p0 needs three.
+    let hertz_n: &'static [usize] = if a.quick { &[20, 25, 35] } else { &[25, 35, 50] };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
-    let cases: [(&str, Case); 4] = [
+    let cases: [(&str, Case); 5] = [
         ("slope", Box::new(move || slope::run(slope_n))),
         ("sliding", Box::new(move || sliding::run(slide_n))),
+        ("hertz", Box::new(move || hertz::run(hertz_n))),
         ("impact", Box::new(move || elastic_impact::run(impact_n))),
         ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
     ];

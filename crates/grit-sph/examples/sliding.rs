@@ -4,7 +4,9 @@ fn main() {
         .nth(1)
         .map(|s| s.parse().unwrap())
         .unwrap_or(20);
-    let s = grit_sph::verification::sliding::simulate(n, 0.001).unwrap();
+    let s = grit_sph::verification::sliding::simulate(n, 0.001)
+        .unwrap()
+        .0;
     println!("{:?}", grit_sph::verification::sliding::errors(&s));
     for (t, v) in s.iter().step_by(100) {
         println!(

@@ -1,8 +1,8 @@
 //! The verification cases at CI resolution, with the tolerances of the issue; `grit verify`
 //! runs the same code at full resolution.
 
-use grit_sph::verification::{elastic_impact, hourglass, slope};
-use grit_sph::ContactModel;
+use grit_sph::verification::{elastic_impact, hertz, hourglass, sliding, slope};
+use grit_sph::{ContactModel, Material};
 
 #[test]
 fn slope_slider_follows_eq_30_within_2_percent() {
@@ -47,4 +47,40 @@ fn hourglass_modes_grow_without_control_and_stay_bounded_with_it() {
     for row in &r.rows {
         assert!(row.pass, "{row:?}");
     }
+}
+
+#[test]
+fn controlled_sliding_sticks_until_0_625_s_then_follows_the_analytic_speed() {
+    let r = sliding::run(20).unwrap();
+    assert_eq!(r.rows.len(), 2);
+    for row in &r.rows {
+        assert!(row.pass, "{row:?}");
+    }
+}
+
+#[test]
+fn hertz_peak_pressure_converges_to_eq_31_and_profile_and_axis_follow_eqs_32_33() {
+    let e = hertz::contact_modulus(&Material::elastic_aluminium());
+    let worst = |snaps: &[hertz::Snapshot]| {
+        snaps
+            .iter()
+            .map(|s| hertz::peak_error(s, e))
+            .fold(0.0, f64::max)
+    };
+    let coarse = hertz::simulate(20, hertz::DENSITY_FILTER).unwrap();
+    let fine = hertz::simulate(25, hertz::DENSITY_FILTER).unwrap();
+    assert_eq!(fine.len(), hertz::LOADS.len());
+    let (ec, ef) = (worst(&coarse), worst(&fine));
+    assert!(
+        ef < ec,
+        "p0 error must shrink with the spacing: {ec} -> {ef}"
+    );
+    let last = fine.last().unwrap();
+    assert!(last.load_n_m >= 50e6);
+    let e50 = hertz::peak_error(last, e);
+    assert!(e50 <= hertz::P0_BOUND, "p0 error at 50 MN/m: {e50}");
+    let p = hertz::pressure_rms(last, e);
+    assert!(p <= hertz::PRESSURE_RMS_BOUND, "pressure RMS {p}");
+    let a = hertz::axis_rms(last, e, 0.3);
+    assert!(a <= hertz::AXIS_RMS_BOUND, "axis-stress RMS {a}");
 }

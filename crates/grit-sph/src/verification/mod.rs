@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 pub mod elastic_impact;
+pub mod hertz;
 pub mod hourglass;
 pub mod sliding;
 pub mod slope;
