@@ -23,6 +23,9 @@ enum Command {
     Shapes(sample_cli::ShapesArgs),
     /// Run one sample (N sequential random impacts on a fresh surface) locally.
     Sample(sample_cli::SampleArgs),
+    /// Job farm: serve, work, run, submit, status, results, cancel, retry-failed, bench.
+    #[command(flatten)]
+    Farm(grit_farm::cli::FarmCommand),
 }
 
 fn main() -> std::process::ExitCode {
@@ -31,6 +34,7 @@ fn main() -> std::process::ExitCode {
         Command::Verify(a) => verify::run(a),
         Command::Shapes(a) => sample_cli::shapes(a),
         Command::Sample(a) => sample_cli::sample(a),
+        Command::Farm(c) => grit_farm::cli::dispatch(c).map_err(anyhow::Error::from),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,310 @@
+//! JSON bodies of the REST API under `/api/v1`, shared by the coordinator and its clients.
+//! Names marked "scripts rely on" in issue 4 are kept exactly.
+
+use std::collections::BTreeMap;
+
+use grit_erosion::{CampaignResults, ImpactParams, ImpactRecord};
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+use uuid::Uuid;
+
+/// Answer to `POST /campaigns`.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct CampaignCreated {
+    /// The campaign id.
+    pub id: Uuid,
+    /// Jobs the campaign expanded into.
+    pub jobs: u64,
+    /// Impacts planned in all.
+    pub impacts_total: u64,
+    /// False when an `Idempotency-Key` matched an earlier submit and nothing new was created.
+    pub created: bool,
+}
+
+/// Campaign state (scripts rely on these names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CampaignState {
+    /// No job has started.
+    Queued,
+    /// Some job has started and some remain.
+    Running,
+    /// Every job is done.
+    Done,
+    /// Nothing remains to run and at least one job failed for good.
+    Failed,
+    /// Cancelled by a user.
+    Cancelled,
+}
+
+impl CampaignState {
+    /// Whether no more work will happen without a user's action.
+    pub fn is_final(self) -> bool {
+        !matches!(self, CampaignState::Queued | CampaignState::Running)
+    }
+}
+
+/// One row of `GET /campaigns`.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct CampaignSummary {
+    /// The campaign id.
+    pub id: Uuid,
+    /// Its name, if given.
+    pub name: Option<String>,
+    /// Its state.
+    pub state: CampaignState,
+    /// Impacts reported so far.
+    pub impacts_done: u64,
+    /// Impacts planned.
+    pub impacts_total: u64,
+    /// Submit time, Unix milliseconds.
+    pub created_ms: i64,
+}
+
+/// Jobs per state.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct JobCounts {
+    /// Waiting for a worker.
+    pub queued: u64,
+    /// Held by a worker.
+    pub leased: u64,
+    /// Finished.
+    pub done: u64,
+    /// Failed after the maximum number of attempts.
+    pub failed: u64,
+    /// Cancelled before finishing.
+    pub cancelled: u64,
+}
+
+/// Progress of one cell.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct CellProgress {
+    /// Cell index.
+    pub cell: u32,
+    /// Impact angle, degrees.
+    pub angle_deg: f64,
+    /// Grain shape name.
+    pub shape: String,
+    /// Other swept values of the cell.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub swept: BTreeMap<String, f64>,
+    /// Samples finished.
+    pub samples_done: u64,
+    /// Samples planned.
+    pub samples_total: u64,
+    /// Impacts reported.
+    pub impacts_done: u64,
+    /// Impacts planned.
+    pub impacts_total: u64,
+}
+
+/// The most recent error of a failed job.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct JobError {
+    /// Job id.
+    pub job_id: i64,
+    /// Cell index.
+    pub cell: u32,
+    /// Sample index.
+    pub sample: u32,
+    /// Attempts lost (expired or failed leases).
+    pub attempts: u32,
+    /// The error message the worker reported.
+    pub error: String,
+}
+
+/// `GET /campaigns/{id}`: progress of one campaign (scripts rely on `id`, `state`,
+/// `impacts_done`, `impacts_total`).
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct CampaignStatus {
+    /// The campaign id.
+    pub id: Uuid,
+    /// Its name, if given.
+    pub name: Option<String>,
+    /// Its state.
+    pub state: CampaignState,
+    /// Impacts reported so far.
+    pub impacts_done: u64,
+    /// Impacts planned.
+    pub impacts_total: u64,
+    /// Jobs per state.
+    pub jobs: JobCounts,
+    /// Impacts per second over the last few minutes; `null` before any impact.
+    pub rate_impacts_per_s: Option<f64>,
+    /// Seconds to finish at that rate; `null` when unknown.
+    pub eta_s: Option<f64>,
+    /// Per-cell progress, in cell order.
+    pub cells: Vec<CellProgress>,
+    /// The last error of any failed job.
+    pub last_error: Option<JobError>,
+    /// Submit time, Unix milliseconds.
+    pub created_ms: i64,
+}
+
+/// The per-impact series of one sample (`?raw=true`).
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct RawSample {
+    /// Cell index.
+    pub cell: u32,
+    /// Sample index within the cell.
+    pub sample: u32,
+    /// The sample's seed.
+    pub seed: u64,
+    /// Job state.
+    pub state: String,
+    /// Every impact reported, in order.
+    #[schema(value_type = Vec<Object>)]
+    pub impacts: Vec<ImpactRecord>,
+}
+
+/// `GET /campaigns/{id}/results`: the science crate's aggregate (scripts rely on `partial`
+/// and `cells[].{angle_deg, shape, samples, erosion_mean, erosion_std}`), plus the raw series
+/// when asked.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct ResultsResponse {
+    /// Aggregated results.
+    #[serde(flatten)]
+    #[schema(value_type = Object)]
+    pub results: CampaignResults,
+    /// Per-impact series of every sample, with `?raw=true`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub raw: Option<Vec<RawSample>>,
+}
+
+/// Answer to cancel and retry-failed: how many jobs changed state.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct JobsChanged {
+    /// Jobs whose state changed.
+    pub jobs: u64,
+}
+
+/// `POST /worker/claim` body.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ClaimRequest {
+    /// A name for the worker (host and process), shown in logs.
+    pub worker: String,
+}
+
+/// A checkpoint of a sample's surface after `impacts_done` impacts.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Checkpoint {
+    /// Impacts the checkpoint contains.
+    pub impacts_done: u32,
+    /// `grit_erosion::Sample::checkpoint` bytes, base64 (standard alphabet, padded).
+    pub data_b64: String,
+}
+
+/// A leased job: everything a worker needs to run (or resume) it.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct ClaimedJob {
+    /// Job id.
+    pub job_id: i64,
+    /// Lease id; every write about this job must carry it.
+    pub lease_id: Uuid,
+    /// Seconds until the lease expires unless renewed.
+    pub lease_ttl_s: f64,
+    /// Campaign id.
+    pub campaign_id: Uuid,
+    /// Cell index.
+    pub cell: u32,
+    /// Sample index.
+    pub sample: u32,
+    /// Seed of the sample.
+    pub seed: u64,
+    /// Impacts planned.
+    pub impacts_planned: u32,
+    /// Impacts already stored by earlier attempts.
+    pub impacts_done: u32,
+    /// The impact scene.
+    #[schema(value_type = Object)]
+    pub params: ImpactParams,
+    /// The latest checkpoint, if any.
+    pub checkpoint: Option<Checkpoint>,
+}
+
+/// Heartbeat: renews the lease and delivers finished impacts and optionally a checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HeartbeatRequest {
+    /// The lease id from the claim.
+    pub lease_id: Uuid,
+    /// Impacts finished since the last acknowledged heartbeat, in order; impacts already
+    /// stored are ignored, so a retried heartbeat is harmless.
+    #[serde(default)]
+    #[schema(value_type = Vec<Object>)]
+    pub impacts: Vec<ImpactRecord>,
+    /// A checkpoint to keep as the job's latest.
+    #[serde(default)]
+    pub checkpoint: Option<Checkpoint>,
+}
+
+/// Answer to a heartbeat.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct HeartbeatResponse {
+    /// Impacts now stored for the job.
+    pub impacts_done: u32,
+    /// New lease expiry, Unix milliseconds.
+    pub lease_expires_ms: i64,
+}
+
+/// Completion: the last impacts; the job must then have all its planned impacts.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CompleteRequest {
+    /// The lease id from the claim.
+    pub lease_id: Uuid,
+    /// Impacts not yet acknowledged.
+    #[serde(default)]
+    #[schema(value_type = Vec<Object>)]
+    pub impacts: Vec<ImpactRecord>,
+}
+
+/// Failure report.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FailRequest {
+    /// The lease id from the claim.
+    pub lease_id: Uuid,
+    /// What went wrong.
+    pub error: String,
+    /// Impacts finished before the failure.
+    #[serde(default)]
+    #[schema(value_type = Vec<Object>)]
+    pub impacts: Vec<ImpactRecord>,
+}
+
+/// Release: give the job back without counting an attempt (a worker shutting down).
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ReleaseRequest {
+    /// The lease id from the claim.
+    pub lease_id: Uuid,
+    /// Impacts not yet acknowledged.
+    #[serde(default)]
+    #[schema(value_type = Vec<Object>)]
+    pub impacts: Vec<ImpactRecord>,
+    /// A checkpoint to resume from.
+    #[serde(default)]
+    pub checkpoint: Option<Checkpoint>,
+}
+
+/// Every error body: a message, and the offending field when there is one.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct ErrorBody {
+    /// What went wrong.
+    pub error: String,
+    /// Path of the offending field, when the request had one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field: Option<String>,
+}
+
+/// `GET /healthz`.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct Health {
+    /// Always "ok" when the database answers.
+    pub status: String,
+    /// Crate version.
+    pub version: String,
+}

@@ -1,0 +1,183 @@
+//! `grit bench farm`: the coordinator alone under load. Clients claim a job, send one
+//! heartbeat and complete it with a placeholder impact; nothing is simulated (the only place
+//! in grit where a job does no simulation), so the figures are the coordinator's own cost.
+
+use std::time::{Duration, Instant};
+
+use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::{ImpactOutcome, ImpactRecord};
+use serde::Serialize;
+
+use crate::api::{CompleteRequest, HeartbeatRequest};
+use crate::client::Client;
+use crate::db::Store;
+use crate::server::{self, Config, Secret};
+
+/// Figures of one concurrency level.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchRow {
+    /// Concurrent clients.
+    pub clients: usize,
+    /// Jobs claimed and completed.
+    pub jobs: u64,
+    /// Seconds measured.
+    pub seconds: f64,
+    /// Claims plus completions per second.
+    pub claims_completions_per_s: f64,
+    /// Median heartbeat latency, ms.
+    pub heartbeat_p50_ms: f64,
+    /// 99th-percentile heartbeat latency, ms.
+    pub heartbeat_p99_ms: f64,
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let i = ((sorted.len() - 1) as f64 * p).round() as usize;
+    sorted[i]
+}
+
+/// Runs the benchmark for each client count, `seconds` each, on a fresh database in `dir`.
+pub async fn run(
+    dir: &std::path::Path,
+    clients: &[usize],
+    seconds: f64,
+) -> Result<Vec<BenchRow>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    let db = dir.join(format!("bench-{}.db", uuid::Uuid::new_v4()));
+    let store = Store::open(&db, Duration::from_secs(60), 3)
+        .await
+        .map_err(|e| e.to_string())?;
+    let token = uuid::Uuid::new_v4().to_string();
+    let config = Config {
+        submit_token: Secret::new(Some(token.clone())),
+        worker_token: Secret::new(Some(token.clone())),
+        ..Config::default()
+    };
+    let running = server::start("127.0.0.1:0", store.clone(), config)
+        .await
+        .map_err(|e| e.to_string())?;
+    let base = format!("http://{}", running.addr);
+    let mut rows = Vec::new();
+    for &n in clients {
+        // Enough jobs that the queue never runs dry during the measurement.
+        let spec = CampaignSpec::from_json(
+            r#"{"angles_deg": [90], "shapes": ["hexagon"], "impacts": 1, "samples": 20000,
+                "allow_short_samples": true, "spacing_m": 25e-6}"#,
+        )
+        .map_err(|e| e.to_string())?;
+        store
+            .create_campaign(&spec, None)
+            .await
+            .map_err(|e| e.to_string())?;
+        let deadline = Instant::now() + Duration::from_secs_f64(seconds);
+        let start = Instant::now();
+        let mut tasks = Vec::new();
+        for i in 0..n {
+            let client =
+                Client::new(&base, Secret::new(Some(token.clone()))).map_err(|e| e.to_string())?;
+            tasks.push(tokio::spawn(client_loop(
+                client,
+                format!("bench-{i}"),
+                deadline,
+            )));
+        }
+        let mut jobs = 0;
+        let mut lat = Vec::new();
+        for t in tasks {
+            let (j, l) = t.await.map_err(|e| e.to_string())??;
+            jobs += j;
+            lat.extend(l);
+        }
+        let secs = start.elapsed().as_secs_f64();
+        lat.sort_by(f64::total_cmp);
+        let row = BenchRow {
+            clients: n,
+            jobs,
+            seconds: secs,
+            claims_completions_per_s: 2.0 * jobs as f64 / secs,
+            heartbeat_p50_ms: percentile(&lat, 0.50),
+            heartbeat_p99_ms: percentile(&lat, 0.99),
+        };
+        tracing::info!(?row, "bench level done");
+        rows.push(row);
+        // Drop the rest of the queue so the next level starts from the same state.
+        for c in store.list_campaigns().await.map_err(|e| e.to_string())? {
+            store.cancel(c.id).await.map_err(|e| e.to_string())?;
+        }
+    }
+    running.stop().await;
+    let _ = std::fs::remove_file(&db);
+    let _ = std::fs::remove_file(db.with_extension("db-wal"));
+    let _ = std::fs::remove_file(db.with_extension("db-shm"));
+    Ok(rows)
+}
+
+async fn client_loop(
+    client: Client,
+    name: String,
+    deadline: Instant,
+) -> Result<(u64, Vec<f64>), String> {
+    let mut jobs = 0;
+    let mut lat = Vec::new();
+    while Instant::now() < deadline {
+        let Some(job) = client.claim(&name).await.map_err(|e| e.to_string())? else {
+            break;
+        };
+        let t = Instant::now();
+        client
+            .heartbeat(
+                job.job_id,
+                &HeartbeatRequest {
+                    lease_id: job.lease_id,
+                    impacts: vec![],
+                    checkpoint: None,
+                },
+            )
+            .await
+            .map_err(|e| e.to_string())?;
+        lat.push(t.elapsed().as_secs_f64() * 1e3);
+        let record = ImpactRecord {
+            impact: 1,
+            grain_mass_kg: job.params.grain_mass_kg_m(),
+            mass_loss_kg: 0.0,
+            orientation_rad: 0.0,
+            aim_x_m: 0.0,
+            outcome: ImpactOutcome {
+                mass_loss_kg: 0.0,
+                removed_particles: 0,
+                sim_time_s: 0.0,
+                steps: 0,
+                rebound_ratio: 0.0,
+                settled: true,
+            },
+        };
+        client
+            .complete(
+                job.job_id,
+                &CompleteRequest {
+                    lease_id: job.lease_id,
+                    impacts: vec![record],
+                },
+            )
+            .await
+            .map_err(|e| e.to_string())?;
+        jobs += 1;
+    }
+    Ok((jobs, lat))
+}
+
+/// The rows as a Markdown table.
+pub fn table(rows: &[BenchRow]) -> String {
+    let mut s = String::from(
+        "| clients | jobs | claims+completions/s | heartbeat p50 (ms) | heartbeat p99 (ms) |\n|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "| {} | {} | {:.0} | {:.2} | {:.2} |\n",
+            r.clients, r.jobs, r.claims_completions_per_s, r.heartbeat_p50_ms, r.heartbeat_p99_ms
+        ));
+    }
+    s
+}

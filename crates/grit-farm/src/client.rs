@@ -1,0 +1,236 @@
+//! HTTP client of the coordinator API, used by the CLI, the worker and the benchmark.
+
+use std::time::Duration;
+
+use reqwest::StatusCode;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use uuid::Uuid;
+
+use crate::api::*;
+use crate::server::Secret;
+
+/// Why a call failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ClientError {
+    /// The coordinator could not be reached (connection refused, timeout); worth retrying.
+    #[error("coordinator unreachable: {0}")]
+    Unreachable(String),
+    /// The coordinator answered with an error status.
+    #[error("HTTP {status}: {message}")]
+    Status {
+        /// HTTP status.
+        status: StatusCode,
+        /// The error body's message.
+        message: String,
+        /// The field it names, if any.
+        field: Option<String>,
+    },
+    /// The answer was not the expected JSON.
+    #[error("unexpected answer: {0}")]
+    Decode(String),
+}
+
+impl ClientError {
+    /// The HTTP status, for an error answer.
+    pub fn status(&self) -> Option<StatusCode> {
+        match self {
+            ClientError::Status { status, .. } => Some(*status),
+            _ => None,
+        }
+    }
+
+    /// Whether trying again later may succeed (unreachable, or a 5xx answer).
+    pub fn is_transient(&self) -> bool {
+        match self {
+            ClientError::Unreachable(_) => true,
+            ClientError::Status { status, .. } => status.is_server_error(),
+            ClientError::Decode(_) => false,
+        }
+    }
+}
+
+/// A coordinator at a base URL, with a bearer token.
+#[derive(Clone)]
+pub struct Client {
+    http: reqwest::Client,
+    base: String,
+    token: Secret,
+}
+
+impl Client {
+    /// A client for `base` (e.g. `http://127.0.0.1:8080`), sending `token` if any.
+    pub fn new(base: &str, token: Secret) -> Result<Client, ClientError> {
+        let http = reqwest::Client::builder()
+            .connect_timeout(Duration::from_secs(10))
+            .timeout(Duration::from_secs(300))
+            .build()
+            .map_err(|e| ClientError::Unreachable(e.to_string()))?;
+        Ok(Client {
+            http,
+            base: base.trim_end_matches('/').to_string(),
+            token,
+        })
+    }
+
+    /// The base URL.
+    pub fn base(&self) -> &str {
+        &self.base
+    }
+
+    fn url(&self, path: &str) -> String {
+        format!("{}/api/v1{path}", self.base)
+    }
+
+    fn auth(&self, rb: reqwest::RequestBuilder) -> reqwest::RequestBuilder {
+        match self.token.expose() {
+            Some(t) => rb.bearer_auth(t),
+            None => rb,
+        }
+    }
+
+    async fn send(&self, rb: reqwest::RequestBuilder) -> Result<reqwest::Response, ClientError> {
+        let resp = self
+            .auth(rb)
+            .send()
+            .await
+            .map_err(|e| ClientError::Unreachable(e.to_string()))?;
+        if resp.status().is_success() {
+            return Ok(resp);
+        }
+        let status = resp.status();
+        let text = resp.text().await.unwrap_or_default();
+        let (message, field) = match serde_json::from_str::<ErrorBody>(&text) {
+            Ok(b) => (b.error, b.field),
+            Err(_) => (text, None),
+        };
+        Err(ClientError::Status {
+            status,
+            message,
+            field,
+        })
+    }
+
+    async fn json<T: DeserializeOwned>(resp: reqwest::Response) -> Result<T, ClientError> {
+        let bytes = resp
+            .bytes()
+            .await
+            .map_err(|e| ClientError::Unreachable(e.to_string()))?;
+        serde_json::from_slice(&bytes).map_err(|e| ClientError::Decode(e.to_string()))
+    }
+
+    async fn post<B: Serialize, T: DeserializeOwned>(
+        &self,
+        path: &str,
+        body: &B,
+    ) -> Result<T, ClientError> {
+        let resp = self.send(self.http.post(self.url(path)).json(body)).await?;
+        Self::json(resp).await
+    }
+
+    async fn post_empty<B: Serialize>(&self, path: &str, body: &B) -> Result<(), ClientError> {
+        self.send(self.http.post(self.url(path)).json(body)).await?;
+        Ok(())
+    }
+
+    /// Submits campaign spec text; `key` is sent as `Idempotency-Key`.
+    pub async fn submit(
+        &self,
+        spec: &str,
+        key: Option<&str>,
+    ) -> Result<CampaignCreated, ClientError> {
+        let mut rb = self
+            .http
+            .post(self.url("/campaigns"))
+            .header(reqwest::header::CONTENT_TYPE, "application/json")
+            .body(spec.to_string());
+        if let Some(k) = key {
+            rb = rb.header("Idempotency-Key", k);
+        }
+        Self::json(self.send(rb).await?).await
+    }
+
+    /// Lists campaigns.
+    pub async fn list(&self) -> Result<Vec<CampaignSummary>, ClientError> {
+        Self::json(self.send(self.http.get(self.url("/campaigns"))).await?).await
+    }
+
+    /// Progress of a campaign.
+    pub async fn status(&self, id: Uuid) -> Result<CampaignStatus, ClientError> {
+        Self::json(
+            self.send(self.http.get(self.url(&format!("/campaigns/{id}"))))
+                .await?,
+        )
+        .await
+    }
+
+    /// Results JSON of a campaign, as the coordinator sent it.
+    pub async fn results_value(
+        &self,
+        id: Uuid,
+        raw: bool,
+    ) -> Result<serde_json::Value, ClientError> {
+        let url = self.url(&format!("/campaigns/{id}/results?raw={raw}"));
+        Self::json(self.send(self.http.get(url)).await?).await
+    }
+
+    /// Cancels a campaign.
+    pub async fn cancel(&self, id: Uuid) -> Result<JobsChanged, ClientError> {
+        self.post(&format!("/campaigns/{id}/cancel"), &serde_json::json!({}))
+            .await
+    }
+
+    /// Requeues a campaign's failed jobs.
+    pub async fn retry_failed(&self, id: Uuid) -> Result<JobsChanged, ClientError> {
+        self.post(
+            &format!("/campaigns/{id}/retry-failed"),
+            &serde_json::json!({}),
+        )
+        .await
+    }
+
+    /// Leases a job, or `None` when there is none.
+    pub async fn claim(&self, worker: &str) -> Result<Option<ClaimedJob>, ClientError> {
+        let resp = self
+            .send(
+                self.http
+                    .post(self.url("/worker/claim"))
+                    .json(&ClaimRequest {
+                        worker: worker.to_string(),
+                    }),
+            )
+            .await?;
+        if resp.status() == StatusCode::NO_CONTENT {
+            return Ok(None);
+        }
+        Self::json(resp).await.map(Some)
+    }
+
+    /// Renews a lease, delivering impacts and maybe a checkpoint.
+    pub async fn heartbeat(
+        &self,
+        job: i64,
+        req: &HeartbeatRequest,
+    ) -> Result<HeartbeatResponse, ClientError> {
+        self.post(&format!("/worker/jobs/{job}/heartbeat"), req)
+            .await
+    }
+
+    /// Completes a job.
+    pub async fn complete(&self, job: i64, req: &CompleteRequest) -> Result<(), ClientError> {
+        self.post_empty(&format!("/worker/jobs/{job}/complete"), req)
+            .await
+    }
+
+    /// Reports a failed attempt.
+    pub async fn fail(&self, job: i64, req: &FailRequest) -> Result<(), ClientError> {
+        self.post_empty(&format!("/worker/jobs/{job}/fail"), req)
+            .await
+    }
+
+    /// Gives a job back.
+    pub async fn release(&self, job: i64, req: &ReleaseRequest) -> Result<(), ClientError> {
+        self.post_empty(&format!("/worker/jobs/{job}/release"), req)
+            .await
+    }
+}

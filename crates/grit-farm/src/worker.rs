@@ -1,0 +1,428 @@
+//! The worker loop: claim a job, run its impacts in order (each in a blocking thread, rayon
+//! inside the engine), report every finished impact by heartbeat, upload a checkpoint every K
+//! impacts, complete. On stop it abandons the running impact through the engine's cancel
+//! callback, uploads a checkpoint and releases the lease.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use base64::Engine;
+use grit_erosion::{ImpactRecord, Sample};
+
+use crate::api::{
+    Checkpoint, ClaimedJob, CompleteRequest, FailRequest, HeartbeatRequest, ReleaseRequest,
+};
+use crate::client::{Client, ClientError};
+
+/// A stop request shared by a signal handler, the async loop and the engine's cancel callback.
+#[derive(Clone)]
+pub struct Stop {
+    flag: Arc<AtomicBool>,
+    tx: Arc<tokio::sync::watch::Sender<bool>>,
+}
+
+impl Default for Stop {
+    fn default() -> Self {
+        Stop {
+            flag: Arc::new(AtomicBool::new(false)),
+            tx: Arc::new(tokio::sync::watch::channel(false).0),
+        }
+    }
+}
+
+impl Stop {
+    /// Requests the stop.
+    pub fn trigger(&self) {
+        self.flag.store(true, Ordering::SeqCst);
+        self.tx.send_replace(true);
+    }
+
+    /// Whether a stop was requested.
+    pub fn is_set(&self) -> bool {
+        self.flag.load(Ordering::SeqCst)
+    }
+
+    /// Sleeps for `d`, returning early (true) if a stop is requested.
+    pub async fn sleep(&self, d: Duration) -> bool {
+        let mut rx = self.tx.subscribe();
+        if *rx.borrow() {
+            return true;
+        }
+        tokio::select! {
+            _ = tokio::time::sleep(d) => self.is_set(),
+            _ = rx.wait_for(|v| *v) => true,
+        }
+    }
+}
+
+/// How a worker behaves.
+#[derive(Debug, Clone)]
+pub struct WorkerOptions {
+    /// Name reported to the coordinator.
+    pub name: String,
+    /// Threads of the engine's rayon pool; `None` uses rayon's global pool.
+    pub threads: Option<usize>,
+    /// Upload a checkpoint every this many impacts.
+    pub checkpoint_every: u32,
+    /// Exit once the queue is empty instead of polling.
+    pub exit_when_idle: bool,
+    /// Wait between claims when the queue is empty.
+    pub idle_poll: Duration,
+    /// Longest wait between retries while the coordinator is unreachable.
+    pub max_backoff: Duration,
+}
+
+impl Default for WorkerOptions {
+    fn default() -> Self {
+        WorkerOptions {
+            name: default_name(),
+            threads: None,
+            checkpoint_every: 5,
+            exit_when_idle: false,
+            idle_poll: Duration::from_secs(2),
+            max_backoff: Duration::from_secs(60),
+        }
+    }
+}
+
+/// `host:pid`, so a job in the coordinator log names the process that held it.
+pub fn default_name() -> String {
+    let host = std::env::var("HOSTNAME")
+        .ok()
+        .or_else(|| std::fs::read_to_string("/etc/hostname").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "worker".into());
+    format!("{host}:{}", std::process::id())
+}
+
+/// What a worker did before it stopped.
+#[derive(Debug, Clone, Default)]
+pub struct WorkerSummary {
+    /// Jobs completed.
+    pub jobs_done: u64,
+    /// Impacts simulated.
+    pub impacts: u64,
+}
+
+/// A failure that stops the worker (bad token, an answer it cannot understand).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct WorkerError(pub String);
+
+enum JobEnd {
+    Done,
+    Lost(String),
+    Failed,
+    Stopped,
+}
+
+struct Runner {
+    client: Client,
+    opts: WorkerOptions,
+    stop: Stop,
+    pool: Option<Arc<rayon::ThreadPool>>,
+    summary: WorkerSummary,
+}
+
+/// Runs the worker loop until `stop` is triggered (or the queue is empty with
+/// `exit_when_idle`).
+pub async fn run(
+    client: Client,
+    opts: WorkerOptions,
+    stop: Stop,
+) -> Result<WorkerSummary, WorkerError> {
+    let pool = match opts.threads {
+        Some(n) => Some(Arc::new(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n.max(1))
+                .thread_name(|i| format!("grit-engine-{i}"))
+                .build()
+                .map_err(|e| WorkerError(format!("--threads: {e}")))?,
+        )),
+        None => None,
+    };
+    let mut r = Runner {
+        client,
+        opts,
+        stop,
+        pool,
+        summary: WorkerSummary::default(),
+    };
+    let mut backoff = Duration::from_millis(500);
+    loop {
+        if r.stop.is_set() {
+            break;
+        }
+        match r.client.claim(&r.opts.name).await {
+            Ok(Some(job)) => {
+                backoff = Duration::from_millis(500);
+                tracing::info!(
+                    job = job.job_id,
+                    cell = job.cell,
+                    sample = job.sample,
+                    done = job.impacts_done,
+                    planned = job.impacts_planned,
+                    "job leased"
+                );
+                match r.run_job(job).await {
+                    JobEnd::Done => r.summary.jobs_done += 1,
+                    JobEnd::Lost(why) => tracing::warn!(%why, "job dropped"),
+                    JobEnd::Failed => {}
+                    JobEnd::Stopped => break,
+                }
+            }
+            Ok(None) => {
+                if r.opts.exit_when_idle {
+                    break;
+                }
+                if r.stop.sleep(r.opts.idle_poll).await {
+                    break;
+                }
+            }
+            Err(e) if e.is_transient() => {
+                tracing::warn!(error = %e, retry_in_s = backoff.as_secs_f64(), "claim failed");
+                if r.stop.sleep(backoff).await {
+                    break;
+                }
+                backoff = (backoff * 2).min(r.opts.max_backoff);
+            }
+            Err(e) => return Err(WorkerError(format!("claim refused: {e}"))),
+        }
+    }
+    Ok(r.summary)
+}
+
+fn encode(sample: &Sample) -> Checkpoint {
+    Checkpoint {
+        impacts_done: sample.impacts_done(),
+        data_b64: base64::engine::general_purpose::STANDARD.encode(sample.checkpoint()),
+    }
+}
+
+impl Runner {
+    /// The sample to continue: from the checkpoint when it can be read, else from scratch
+    /// (impacts the coordinator already has are re-run and skipped by it, bit-identical).
+    fn open_sample(job: &ClaimedJob) -> Result<Sample, String> {
+        if let Some(c) = &job.checkpoint {
+            let resumed = base64::engine::general_purpose::STANDARD
+                .decode(&c.data_b64)
+                .map_err(|e| e.to_string())
+                .and_then(|b| Sample::resume(&job.params, job.seed, &b).map_err(|e| e.to_string()));
+            match resumed {
+                Ok(s) => {
+                    tracing::info!(
+                        job = job.job_id,
+                        impacts = s.impacts_done(),
+                        "resumed from checkpoint"
+                    );
+                    return Ok(s);
+                }
+                Err(e) => {
+                    tracing::warn!(job = job.job_id, error = %e, "checkpoint unusable; starting the sample again")
+                }
+            }
+        }
+        Sample::new(job.params.clone(), job.seed).map_err(|e| e.to_string())
+    }
+
+    async fn run_job(&mut self, job: ClaimedJob) -> JobEnd {
+        let mut sample = match Self::open_sample(&job) {
+            Ok(s) => s,
+            Err(e) => {
+                let req = FailRequest {
+                    lease_id: job.lease_id,
+                    error: format!("cannot set up the sample: {e}"),
+                    impacts: vec![],
+                };
+                if let Err(e) = self.client.fail(job.job_id, &req).await {
+                    tracing::warn!(error = %e, "reporting the failure failed");
+                }
+                return JobEnd::Failed;
+            }
+        };
+        let mut pending: Vec<ImpactRecord> = sample
+            .records()
+            .iter()
+            .filter(|r| r.impact > job.impacts_done)
+            .cloned()
+            .collect();
+        let tick = Duration::from_secs_f64((job.lease_ttl_s / 3.0).max(0.2));
+        let lost = Arc::new(AtomicBool::new(false));
+        let mut checkpoint_due = false;
+        while sample.impacts_done() < job.impacts_planned {
+            if self.stop.is_set() {
+                return self.release(&job, &sample, pending).await;
+            }
+            let stop = self.stop.clone();
+            let lost_flag = lost.clone();
+            let pool = self.pool.clone();
+            let mut handle = tokio::task::spawn_blocking(move || {
+                let cancel = || stop.is_set() || lost_flag.load(Ordering::SeqCst);
+                let result = match &pool {
+                    Some(p) => p.install(|| sample.run_next_cancellable(&cancel).cloned()),
+                    None => sample.run_next_cancellable(&cancel).cloned(),
+                };
+                (sample, result)
+            });
+            // Keep the lease alive while the impact runs (it can take minutes).
+            let (s, result) = loop {
+                tokio::select! {
+                    joined = &mut handle => match joined {
+                        Ok(v) => break v,
+                        Err(e) => return self.fail(&job, format!("impact thread panicked: {e}"), pending).await,
+                    },
+                    _ = tokio::time::sleep(tick) => {
+                        match self.heartbeat(&job, &mut pending, None).await {
+                            Ok(()) => {}
+                            Err(Some(why)) => { lost.store(true, Ordering::SeqCst); tracing::warn!(%why, "lease lost; abandoning the impact"); }
+                            Err(None) => {}
+                        }
+                    }
+                }
+            };
+            sample = s;
+            match result {
+                Ok(rec) => {
+                    self.summary.impacts += 1;
+                    tracing::info!(
+                        job = job.job_id,
+                        impact = rec.impact,
+                        mass_loss_kg = rec.mass_loss_kg,
+                        "impact done"
+                    );
+                    pending.push(rec);
+                }
+                Err(_) if lost.load(Ordering::SeqCst) => {
+                    return JobEnd::Lost("lease lost while the impact ran".into())
+                }
+                Err(_) if self.stop.is_set() => return self.release(&job, &sample, pending).await,
+                Err(e) => return self.fail(&job, e.to_string(), pending).await,
+            }
+            if sample.impacts_done() % self.opts.checkpoint_every.max(1) == 0
+                && sample.impacts_done() < job.impacts_planned
+            {
+                checkpoint_due = true;
+            }
+            let ckpt = checkpoint_due.then(|| encode(&sample));
+            match self.heartbeat(&job, &mut pending, ckpt).await {
+                Ok(()) => checkpoint_due = false,
+                Err(Some(why)) => return JobEnd::Lost(why),
+                Err(None) => {}
+            }
+        }
+        self.complete(&job, pending).await
+    }
+
+    /// Sends the pending impacts; clears them once acknowledged. `Err(Some)` means the lease
+    /// is gone (409/410/404); `Err(None)` a transient failure (impacts kept for the next try).
+    async fn heartbeat(
+        &self,
+        job: &ClaimedJob,
+        pending: &mut Vec<ImpactRecord>,
+        checkpoint: Option<Checkpoint>,
+    ) -> Result<(), Option<String>> {
+        let req = HeartbeatRequest {
+            lease_id: job.lease_id,
+            impacts: pending.clone(),
+            checkpoint,
+        };
+        match self.client.heartbeat(job.job_id, &req).await {
+            Ok(_) => {
+                pending.clear();
+                Ok(())
+            }
+            Err(e) if e.is_transient() => {
+                tracing::warn!(error = %e, pending = pending.len(), "heartbeat failed; impacts kept for the next one");
+                Err(None)
+            }
+            Err(e) => Err(Some(e.to_string())),
+        }
+    }
+
+    /// Retries `call` with backoff while the coordinator is unreachable; gives up after
+    /// `limit` when stopping (the lease then expires and the job is resumed elsewhere).
+    async fn deliver<F, Fut>(&self, what: &str, mut call: F) -> Result<(), ClientError>
+    where
+        F: FnMut() -> Fut,
+        Fut: std::future::Future<Output = Result<(), ClientError>>,
+    {
+        let mut backoff = Duration::from_millis(500);
+        let mut waited = Duration::ZERO;
+        loop {
+            match call().await {
+                Err(e) if e.is_transient() => {
+                    if self.stop.is_set() && waited > Duration::from_secs(30) {
+                        return Err(e);
+                    }
+                    tracing::warn!(error = %e, what, retry_in_s = backoff.as_secs_f64(), "coordinator unreachable");
+                    tokio::time::sleep(backoff).await;
+                    waited += backoff;
+                    backoff = (backoff * 2).min(self.opts.max_backoff);
+                }
+                other => return other,
+            }
+        }
+    }
+
+    async fn complete(&self, job: &ClaimedJob, pending: Vec<ImpactRecord>) -> JobEnd {
+        let req = CompleteRequest {
+            lease_id: job.lease_id,
+            impacts: pending,
+        };
+        match self
+            .deliver("complete", || self.client.complete(job.job_id, &req))
+            .await
+        {
+            Ok(()) => {
+                tracing::info!(job = job.job_id, "job complete");
+                JobEnd::Done
+            }
+            Err(e) => JobEnd::Lost(format!("complete refused: {e}")),
+        }
+    }
+
+    async fn fail(&self, job: &ClaimedJob, error: String, pending: Vec<ImpactRecord>) -> JobEnd {
+        tracing::error!(job = job.job_id, %error, "job failed");
+        let req = FailRequest {
+            lease_id: job.lease_id,
+            error,
+            impacts: pending,
+        };
+        if let Err(e) = self
+            .deliver("fail", || self.client.fail(job.job_id, &req))
+            .await
+        {
+            tracing::warn!(error = %e, "reporting the failure failed");
+        }
+        JobEnd::Failed
+    }
+
+    async fn release(
+        &self,
+        job: &ClaimedJob,
+        sample: &Sample,
+        pending: Vec<ImpactRecord>,
+    ) -> JobEnd {
+        let req = ReleaseRequest {
+            lease_id: job.lease_id,
+            impacts: pending,
+            checkpoint: Some(encode(sample)),
+        };
+        match self
+            .deliver("release", || self.client.release(job.job_id, &req))
+            .await
+        {
+            Ok(()) => tracing::info!(
+                job = job.job_id,
+                impacts = sample.impacts_done(),
+                "job released with a checkpoint"
+            ),
+            Err(e) => {
+                tracing::warn!(job = job.job_id, error = %e, "release failed; the lease will expire")
+            }
+        }
+        JobEnd::Stopped
+    }
+}

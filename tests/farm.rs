@@ -1,0 +1,599 @@
+//! End-to-end tests of the job farm (issue 4): the real `grit` binary as coordinator and
+//! workers over loopback, a fresh SQLite file per test, and real (coarse) SPH impacts.
+//! Set TEST_LOG=1 to see the processes' logs on failure paths.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use grit_erosion::ImpactRecord;
+use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_farm::{Client, Secret};
+use serde_json::Value;
+use uuid::Uuid;
+
+const GRIT: &str = env!("CARGO_BIN_EXE_grit");
+const SUBMIT: &str = "submit-token-for-tests";
+const WORKER: &str = "worker-token-for-tests";
+
+/// The tests share two cores and time leases, so they run one at a time (a tokio mutex: the
+/// guard is held across awaits, and a failed test must not poison it for the others).
+static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
+
+/// The coarsest real scene: 10 particles per grain diameter on a small surface.
+fn campaign(samples: u32, impacts: u32) -> String {
+    format!(
+        r#"{{"name": "e2e", "seed": 11, "angles_deg": [60], "shapes": ["hexagon"],
+            "samples": {samples}, "impacts": {impacts}, "allow_short_samples": true,
+            "spacing_m": 25e-6, "surface_width_dg": 3.0, "surface_depth_dg": 1.3}}"#
+    )
+}
+
+struct Proc {
+    child: Child,
+    log: PathBuf,
+}
+
+impl Proc {
+    fn log_text(&self) -> String {
+        std::fs::read_to_string(&self.log).unwrap_or_default()
+    }
+
+    fn kill9(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        self.kill9();
+        if std::env::var_os("TEST_LOG").is_some() {
+            eprintln!("--- {} ---\n{}", self.log.display(), self.log_text());
+        }
+    }
+}
+
+struct Coordinator {
+    proc: Proc,
+    url: String,
+}
+
+fn start_coordinator(dir: &Path, listen: &str, lease_ttl_s: f64, tag: &str) -> Coordinator {
+    let log = dir.join(format!("coordinator-{tag}.log"));
+    let mut child = Command::new(GRIT)
+        .args(["serve", "--db"])
+        .arg(dir.join("farm.db"))
+        .args([
+            "--listen",
+            listen,
+            "--lease-ttl-s",
+            &lease_ttl_s.to_string(),
+        ])
+        .args(["--max-spec-bytes", "65536"])
+        .env("GRIT_SUBMIT_TOKEN", SUBMIT)
+        .env("GRIT_WORKER_TOKEN", WORKER)
+        .env("RUST_LOG", "info")
+        .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .expect("grit serve starts");
+    let stdout = child.stdout.take().unwrap();
+    let mut line = String::new();
+    BufReader::new(stdout).read_line(&mut line).unwrap();
+    let url = line
+        .trim()
+        .rsplit(' ')
+        .next()
+        .filter(|u| u.starts_with("http://"))
+        .unwrap_or_else(|| panic!("no address line from grit serve: {line:?}"))
+        .to_string();
+    Coordinator {
+        proc: Proc { child, log },
+        url,
+    }
+}
+
+fn start_worker(dir: &Path, url: &str, tag: &str) -> Proc {
+    let log = dir.join(format!("worker-{tag}.log"));
+    let child = Command::new(GRIT)
+        .args(["work", "--coordinator", url, "--token", WORKER])
+        .args([
+            "--threads",
+            "1",
+            "--checkpoint-every",
+            "1",
+            "--poll-s",
+            "0.2",
+        ])
+        .args(["--name", tag])
+        .env("RUST_LOG", "info")
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .expect("grit work starts");
+    Proc { child, log }
+}
+
+fn submitter(url: &str) -> Client {
+    Client::new(url, Secret::new(Some(SUBMIT.into()))).unwrap()
+}
+
+fn worker_client(url: &str) -> Client {
+    Client::new(url, Secret::new(Some(WORKER.into()))).unwrap()
+}
+
+/// Polls the campaign until `done` holds, failing after `limit`.
+async fn wait_for(
+    c: &Client,
+    id: Uuid,
+    limit: Duration,
+    what: &str,
+    done: impl Fn(&CampaignStatus) -> bool,
+) -> CampaignStatus {
+    let start = Instant::now();
+    loop {
+        if let Ok(s) = c.status(id).await {
+            if done(&s) {
+                return s;
+            }
+            assert!(
+                start.elapsed() < limit,
+                "timed out waiting for {what}; last status {s:?}"
+            );
+        } else {
+            assert!(start.elapsed() < limit, "timed out waiting for {what}");
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+}
+
+fn raw_series(results: &Value) -> Vec<(u64, u64, Vec<ImpactRecord>)> {
+    results["raw"]
+        .as_array()
+        .expect("raw series present")
+        .iter()
+        .map(|s| {
+            (
+                s["cell"].as_u64().unwrap(),
+                s["sample"].as_u64().unwrap(),
+                serde_json::from_value(s["impacts"].clone()).unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Bit-for-bit equality of two sets of per-impact series.
+fn assert_bitwise_equal(a: &[(u64, u64, Vec<ImpactRecord>)], b: &[(u64, u64, Vec<ImpactRecord>)]) {
+    assert_eq!(a.len(), b.len());
+    for ((ca, sa, ra), (cb, sb, rb)) in a.iter().zip(b) {
+        assert_eq!((ca, sa), (cb, sb));
+        assert_eq!(ra.len(), rb.len(), "cell {ca} sample {sa}: impact counts");
+        for (x, y) in ra.iter().zip(rb) {
+            assert_eq!(
+                x.mass_loss_kg.to_bits(),
+                y.mass_loss_kg.to_bits(),
+                "impact {}",
+                x.impact
+            );
+            assert_eq!(x.grain_mass_kg.to_bits(), y.grain_mass_kg.to_bits());
+            assert_eq!(x.orientation_rad.to_bits(), y.orientation_rad.to_bits());
+            assert_eq!(x.aim_x_m.to_bits(), y.aim_x_m.to_bits());
+            assert_eq!(
+                x.outcome.sim_time_s.to_bits(),
+                y.outcome.sim_time_s.to_bits()
+            );
+            assert_eq!(x, y);
+        }
+    }
+}
+
+/// `grit run` of `spec` into `out`; returns results.json.
+fn grit_run(dir: &Path, spec: &str, out: &str, raw: bool) -> Value {
+    let file = dir.join(format!("{out}.json"));
+    std::fs::write(&file, spec).unwrap();
+    let out_dir = dir.join(out);
+    let mut cmd = Command::new(GRIT);
+    cmd.arg("run")
+        .arg(&file)
+        .args(["--workers", "1", "--threads", "1", "--quiet", "--out"])
+        .arg(&out_dir);
+    if raw {
+        cmd.arg("--raw");
+    }
+    let status = cmd.status().expect("grit run starts");
+    assert!(status.success(), "grit run failed");
+    serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap()
+}
+
+fn grit_cli(url: &str, args: &[&str]) -> std::process::Output {
+    Command::new(GRIT)
+        .args(args)
+        .env("GRIT_COORDINATOR", url)
+        .env("GRIT_TOKEN", SUBMIT)
+        .output()
+        .expect("grit runs")
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn two_workers_complete_a_campaign_and_match_grit_run() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = campaign(2, 2);
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let file = dir.path().join("spec.json");
+    std::fs::write(&file, &spec).unwrap();
+    let out = grit_cli(&coord.url, &["submit", file.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let id: Uuid = stdout.lines().last().unwrap().trim().parse().unwrap();
+    let _w1 = start_worker(dir.path(), &coord.url, "w1");
+    let _w2 = start_worker(dir.path(), &coord.url, "w2");
+    let c = submitter(&coord.url);
+    let s = wait_for(&c, id, Duration::from_secs(120), "done", |s| {
+        s.state.is_final()
+    })
+    .await;
+    assert_eq!(s.state, CampaignState::Done);
+    assert_eq!(s.impacts_done, s.impacts_total);
+    assert_eq!(s.impacts_total, 4);
+    let farm = c.results_value(id, false).await.unwrap();
+    assert_eq!(farm["partial"], Value::Bool(false));
+    let local = grit_run(dir.path(), &spec, "local", false);
+    assert_eq!(farm, local, "farm results equal grit run results");
+    // Both workers took part (one job each, claimed in parallel).
+    assert!(_w1.log_text().contains("job complete") && _w2.log_text().contains("job complete"));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn killed_worker_is_resumed_from_checkpoint_bit_for_bit() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = campaign(1, 6);
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 2.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let mut w1 = start_worker(dir.path(), &coord.url, "w1");
+    wait_for(&c, id, Duration::from_secs(120), "2 impacts", |s| {
+        s.impacts_done >= 2
+    })
+    .await;
+    w1.kill9();
+    let before = c.status(id).await.unwrap();
+    assert!(
+        before.impacts_done < 6,
+        "the job must still be running when killed"
+    );
+    let w2 = start_worker(dir.path(), &coord.url, "w2");
+    let s = wait_for(&c, id, Duration::from_secs(120), "done", |s| {
+        s.state.is_final()
+    })
+    .await;
+    assert_eq!(s.state, CampaignState::Done);
+    assert!(
+        w2.log_text().contains("resumed from checkpoint"),
+        "the second worker resumes from the checkpoint:\n{}",
+        w2.log_text()
+    );
+    let farm = raw_series(&c.results_value(id, true).await.unwrap());
+    let local = raw_series(&grit_run(dir.path(), &spec, "local", true));
+    assert_bitwise_equal(&farm, &local);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn coordinator_restart_loses_nothing() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = campaign(2, 4);
+    let mut coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let url = coord.url.clone();
+    let c = submitter(&url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let w1 = start_worker(dir.path(), &url, "w1");
+    let w2 = start_worker(dir.path(), &url, "w2");
+    let mid = wait_for(&c, id, Duration::from_secs(120), "some impacts", |s| {
+        s.impacts_done >= 2
+    })
+    .await;
+    coord.proc.kill9();
+    tokio::time::sleep(Duration::from_secs(2)).await;
+    let listen = url.trim_start_matches("http://").to_string();
+    let _coord2 = start_coordinator(dir.path(), &listen, 30.0, "b");
+    let after = c.status(id).await.unwrap();
+    assert!(
+        after.impacts_done >= mid.impacts_done,
+        "nothing stored was lost"
+    );
+    let s = wait_for(&c, id, Duration::from_secs(180), "done", |s| {
+        s.state.is_final()
+    })
+    .await;
+    assert_eq!(s.state, CampaignState::Done);
+    assert_eq!(s.impacts_done, 8);
+    let farm = raw_series(&c.results_value(id, true).await.unwrap());
+    for (_, _, records) in &farm {
+        let numbers: Vec<u32> = records.iter().map(|r| r.impact).collect();
+        assert_eq!(numbers, vec![1, 2, 3, 4]);
+    }
+    let local = raw_series(&grit_run(dir.path(), &spec, "local", true));
+    assert_bitwise_equal(&farm, &local);
+    assert!(w1.log_text().contains("unreachable") || w2.log_text().contains("unreachable"));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn stale_worker_gets_409_and_changes_nothing() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 1.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&campaign(1, 2), None).await.unwrap().id;
+    let stale = worker_client(&coord.url);
+    let job = stale.claim("stale").await.unwrap().expect("a job");
+    // A real impact, slower than the 1 s lease.
+    let params = job.params.clone();
+    let seed = job.seed;
+    let record = tokio::task::spawn_blocking(move || {
+        let mut s = grit_erosion::Sample::new(params, seed).unwrap();
+        s.run_next().unwrap().clone()
+    })
+    .await
+    .unwrap();
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let fresh = worker_client(&coord.url)
+        .claim("fresh")
+        .await
+        .unwrap()
+        .expect("requeued job");
+    assert_eq!(fresh.job_id, job.job_id);
+    let hb = grit_farm::api::HeartbeatRequest {
+        lease_id: job.lease_id,
+        impacts: vec![record.clone()],
+        checkpoint: None,
+    };
+    let e = stale.heartbeat(job.job_id, &hb).await.unwrap_err();
+    assert_eq!(e.status().map(|s| s.as_u16()), Some(409), "{e}");
+    let done = grit_farm::api::CompleteRequest {
+        lease_id: job.lease_id,
+        impacts: vec![record],
+    };
+    let e = stale.complete(job.job_id, &done).await.unwrap_err();
+    assert_eq!(e.status().map(|s| s.as_u16()), Some(409), "{e}");
+    let raw = raw_series(&c.results_value(id, true).await.unwrap());
+    assert!(
+        raw[0].2.is_empty(),
+        "nothing from the stale worker was stored"
+    );
+    assert_eq!(c.status(id).await.unwrap().impacts_done, 0);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn auth_validation_size_and_unknown_ids() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let http = reqwest::Client::new();
+    let api = format!("{}/api/v1", coord.url);
+    let status = |r: reqwest::Response| r.status().as_u16();
+
+    // 401: no token, a wrong token, or the other role's token.
+    let r = http.get(format!("{api}/campaigns")).send().await.unwrap();
+    assert_eq!(status(r), 401);
+    let r = http
+        .get(format!("{api}/campaigns"))
+        .bearer_auth("nope")
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status(r), 401);
+    let r = http
+        .get(format!("{api}/campaigns"))
+        .bearer_auth(WORKER)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status(r), 401);
+    let r = http
+        .post(format!("{api}/worker/claim"))
+        .bearer_auth(SUBMIT)
+        .json(&serde_json::json!({"worker": "x"}))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status(r), 401);
+    // Open endpoints.
+    let r = http.get(format!("{api}/healthz")).send().await.unwrap();
+    assert_eq!(status(r), 200);
+    let doc: Value = http
+        .get(format!("{api}/openapi.json"))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert!(doc["paths"]["/api/v1/campaigns"].is_object());
+
+    // 422 naming the field; 400 for malformed JSON.
+    let post = |body: String| {
+        http.post(format!("{api}/campaigns"))
+            .bearer_auth(SUBMIT)
+            .header("content-type", "application/json")
+            .body(body)
+            .send()
+    };
+    let r = post(r#"{"angles_deg": [45, 100]}"#.into()).await.unwrap();
+    assert_eq!(r.status().as_u16(), 422);
+    let body: Value = r.json().await.unwrap();
+    assert_eq!(body["field"], "angles_deg[1]", "{body}");
+    let r = post(r#"{"samples": 3, "colour": "red"}"#.into())
+        .await
+        .unwrap();
+    assert_eq!(r.status().as_u16(), 422);
+    let body: Value = r.json().await.unwrap();
+    assert_eq!(body["field"], "colour", "{body}");
+    let r = post(r#"{"impacts": 5}"#.into()).await.unwrap();
+    assert_eq!(r.status().as_u16(), 422);
+    assert_eq!(r.json::<Value>().await.unwrap()["field"], "impacts");
+    let r = post(r#"{"samples": "#.into()).await.unwrap();
+    assert_eq!(status(r), 400);
+    // The CLI prints the field too and exits non-zero.
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, r#"{"shapes": ["pentagon"]}"#).unwrap();
+    let out = grit_cli(&coord.url, &["submit", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("shapes[0]"));
+
+    // 413 above the body limit (64 KiB in these tests).
+    let big = format!(r#"{{"name": "{}"}}"#, "x".repeat(100_000));
+    let r = post(big).await.unwrap();
+    assert_eq!(status(r), 413);
+
+    // 404 for unknown ids and jobs.
+    let c = submitter(&coord.url);
+    let e = c.status(Uuid::new_v4()).await.unwrap_err();
+    assert_eq!(e.status().map(|s| s.as_u16()), Some(404));
+    let e = c.results_value(Uuid::new_v4(), false).await.unwrap_err();
+    assert_eq!(e.status().map(|s| s.as_u16()), Some(404));
+    let r = http
+        .post(format!("{api}/worker/jobs/999/heartbeat"))
+        .bearer_auth(WORKER)
+        .json(&serde_json::json!({"lease_id": Uuid::new_v4()}))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status(r), 404);
+    // The token never reaches the log.
+    let log = coord.proc.log_text();
+    assert!(!log.contains(SUBMIT) && !log.contains(WORKER));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn repeated_submit_with_idempotency_key_creates_one_campaign() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let c = submitter(&coord.url);
+    let spec = campaign(1, 2);
+    let first = c.submit(&spec, Some("key-1")).await.unwrap();
+    assert!(first.created);
+    let second = c.submit(&spec, Some("key-1")).await.unwrap();
+    assert!(!second.created);
+    assert_eq!(first.id, second.id);
+    let file = dir.path().join("spec.json");
+    std::fs::write(&file, &spec).unwrap();
+    let out = grit_cli(
+        &coord.url,
+        &[
+            "submit",
+            file.to_str().unwrap(),
+            "--idempotency-key",
+            "key-1",
+        ],
+    );
+    assert!(out.status.success());
+    let last = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(last.lines().last().unwrap().trim(), first.id.to_string());
+    assert_eq!(c.list().await.unwrap().len(), 1);
+    // The same key with a different campaign is refused.
+    let e = c.submit(&campaign(2, 2), Some("key-1")).await.unwrap_err();
+    assert_eq!(e.status().map(|s| s.as_u16()), Some(409));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn cancel_stops_handout_and_tells_running_workers() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 3.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&campaign(3, 20), None).await.unwrap().id;
+    let mut w = start_worker(dir.path(), &coord.url, "w1");
+    wait_for(&c, id, Duration::from_secs(60), "a leased job", |s| {
+        s.jobs.leased >= 1
+    })
+    .await;
+    let out = grit_cli(&coord.url, &["cancel", &id.to_string()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = c.status(id).await.unwrap();
+    assert_eq!(s.state, CampaignState::Cancelled);
+    assert_eq!((s.jobs.queued, s.jobs.leased), (0, 0));
+    assert_eq!(s.jobs.cancelled, 3);
+    assert!(worker_client(&coord.url)
+        .claim("probe")
+        .await
+        .unwrap()
+        .is_none());
+    // The worker hears it at its next heartbeat (every lease/3 = 1 s) and drops the job.
+    let start = Instant::now();
+    while !w.log_text().contains("cancelled") {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "worker never told:\n{}",
+            w.log_text()
+        );
+        tokio::time::sleep(Duration::from_millis(200)).await;
+    }
+    assert!(
+        w.child.try_wait().unwrap().is_none(),
+        "the worker keeps running"
+    );
+    w.kill9();
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn sigterm_releases_the_job_with_a_checkpoint_and_exits_0() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&campaign(1, 20), None).await.unwrap().id;
+    let mut w = start_worker(dir.path(), &coord.url, "w1");
+    wait_for(&c, id, Duration::from_secs(60), "an impact", |s| {
+        s.impacts_done >= 1
+    })
+    .await;
+    let pid = w.child.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let start = Instant::now();
+    let code = loop {
+        if let Some(code) = w.child.try_wait().unwrap() {
+            break code;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "worker did not exit"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(code.success(), "exit status {code:?}");
+    assert!(
+        w.log_text().contains("released with a checkpoint"),
+        "{}",
+        w.log_text()
+    );
+    let s = c.status(id).await.unwrap();
+    assert_eq!(
+        (s.jobs.queued, s.jobs.leased),
+        (1, 0),
+        "the job is back in the queue at once"
+    );
+    let job = worker_client(&coord.url)
+        .claim("next")
+        .await
+        .unwrap()
+        .unwrap();
+    assert!(job.checkpoint.is_some());
+    assert_eq!(job.impacts_done, s.impacts_done as u32);
+}
