@@ -149,9 +149,10 @@ pub struct WorkArgs {
 pub struct RunArgs {
     /// Campaign spec JSON (issue 3); `-` reads standard input.
     pub campaign: PathBuf,
-    /// Local workers.
-    #[arg(long, default_value_t = 1)]
-    pub workers: usize,
+    /// Local workers (default: one per core, each with one engine thread, since samples
+    /// are independent and parallelise better than the threads inside one impact).
+    #[arg(long)]
+    pub workers: Option<usize>,
     /// Engine threads per worker (default: cores / workers).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -471,7 +472,9 @@ async fn run(a: RunArgs) -> CliResult {
         .map_err(|e| CliError(format!("{}: {e}", a.campaign.display())))?;
     let opts = crate::embedded::EmbeddedOptions {
         out: a.out.clone(),
-        workers: a.workers,
+        workers: a
+            .workers
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         threads_per_worker: a.threads,
         checkpoint_every: a.checkpoint_every.max(1),
         progress: !a.quiet,

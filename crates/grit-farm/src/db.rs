@@ -903,3 +903,83 @@ fn derive_state(cancelled: bool, c: &JobCounts, total: u64, impacts_done: u64) -
 fn parse_uuid(s: &str) -> Result<Uuid> {
     Uuid::from_str(s).map_err(|e| Error::Internal(format!("stored id {s}: {e}")))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TINY: &str = r#"{"angles_deg": [90], "shapes": ["hexagon"], "samples": 2, "impacts": 2,
+        "allow_short_samples": true, "spacing_m": 25e-6}"#;
+
+    async fn store(dir: &Path, ttl_ms: u64) -> Store {
+        Store::open(&dir.join("t.db"), Duration::from_millis(ttl_ms), 2)
+            .await
+            .unwrap()
+    }
+
+    #[tokio::test]
+    async fn expired_leases_count_attempts_until_the_job_fails() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = store(dir.path(), 1).await;
+        let spec = CampaignSpec::from_json(TINY).unwrap();
+        let id = s.create_campaign(&spec, None).await.unwrap().id;
+        // Sample 0 first (claim order), then the other.
+        let a = s.claim("w").await.unwrap().unwrap();
+        assert_eq!(a.sample, 0);
+        tokio::time::sleep(Duration::from_millis(5)).await;
+        let b = s.claim("w").await.unwrap().unwrap();
+        assert_eq!(
+            b.job_id, a.job_id,
+            "the expired job is first in the queue again"
+        );
+        tokio::time::sleep(Duration::from_millis(5)).await;
+        s.reap_expired().await.unwrap();
+        let st = s.status(id).await.unwrap();
+        assert_eq!(st.jobs.failed, 1);
+        assert_eq!(st.jobs.queued, 1);
+        let e = st.last_error.unwrap();
+        assert_eq!(e.attempts, 2);
+        assert!(e.error.contains("lease expired"), "{}", e.error);
+        assert_eq!(s.retry_failed(id).await.unwrap(), 1);
+        assert_eq!(s.status(id).await.unwrap().jobs.queued, 2);
+    }
+
+    #[tokio::test]
+    async fn failure_reports_keep_the_error_and_stale_leases_get_409() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = store(dir.path(), 60_000).await;
+        let spec = CampaignSpec::from_json(TINY).unwrap();
+        let id = s.create_campaign(&spec, None).await.unwrap().id;
+        let j = s.claim("w").await.unwrap().unwrap();
+        let e = s
+            .heartbeat(j.job_id, Uuid::new_v4(), &[], None)
+            .await
+            .unwrap_err();
+        assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
+        s.fail(j.job_id, j.lease_id, "impact 1: unstable", &[])
+            .await
+            .unwrap();
+        let e = s
+            .fail(j.job_id, j.lease_id, "again", &[])
+            .await
+            .unwrap_err();
+        assert_eq!(
+            e.status(),
+            axum::http::StatusCode::CONFLICT,
+            "the lease ended"
+        );
+        let j2 = s.claim("w").await.unwrap().unwrap();
+        s.fail(j2.job_id, j2.lease_id, "impact 1: unstable", &[])
+            .await
+            .unwrap();
+        let st = s.status(id).await.unwrap();
+        assert_eq!(st.jobs.failed + st.jobs.queued, 2);
+        assert_eq!(
+            st.last_error.map(|e| e.error).as_deref(),
+            Some("impact 1: unstable")
+        );
+        assert_eq!(s.cancel(id).await.unwrap(), 2);
+        assert!(s.claim("w").await.unwrap().is_none());
+        assert_eq!(s.status(id).await.unwrap().state, CampaignState::Cancelled);
+    }
+}
