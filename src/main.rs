@@ -23,9 +23,8 @@ enum Command {
     Shapes(sample_cli::ShapesArgs),
     /// Run one sample (N sequential random impacts on a fresh surface) locally.
     Sample(sample_cli::SampleArgs),
-    /// Job farm: serve, work, run, submit, status, results, cancel, retry-failed, bench.
-    #[command(flatten)]
-    Farm(grit_farm::cli::FarmCommand),
+    /// Checks of the impact scene's own choices: `grit study settle`.
+    Study(sample_cli::StudyArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -34,7 +33,7 @@ fn main() -> std::process::ExitCode {
         Command::Verify(a) => verify::run(a),
         Command::Shapes(a) => sample_cli::shapes(a),
         Command::Sample(a) => sample_cli::sample(a),
-        Command::Farm(c) => grit_farm::cli::dispatch(c).map_err(anyhow::Error::from),
+        Command::Study(a) => sample_cli::study(a),
     };
     match result {
         Ok(code) => code,

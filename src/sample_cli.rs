@@ -45,21 +45,15 @@ pub fn shapes(a: ShapesArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Arguments of `grit sample`.
+/// The impact scene as command-line flags (seed section 4 defaults).
 #[derive(clap::Args)]
-pub struct SampleArgs {
+pub struct SceneArgs {
     /// Impact angle, degrees from the surface, in (0, 90].
     #[arg(long)]
     angle: f64,
     /// Grain shape: octagon, hexagon, square, rectangle or circle.
     #[arg(long, default_value = "hexagon")]
     shape: String,
-    /// Number of impacts on the fresh surface.
-    #[arg(long, default_value_t = 60)]
-    impacts: u32,
-    /// Seed of the random aim points and orientations.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
     /// Particle spacing Δx (m); the seed's is 8e-6.
     #[arg(long)]
     spacing_m: Option<f64>,
@@ -81,6 +75,56 @@ pub struct SampleArgs {
     /// Full scene as JSON (an ImpactParams object); flags above override its fields.
     #[arg(long)]
     scene: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    /// The validated scene; errors name the field and the rule.
+    fn params(&self) -> anyhow::Result<ImpactParams> {
+        let mut p = match &self.scene {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("reading {}", path.display()))?;
+                serde_json::from_str(&text).with_context(|| format!("scene {}", path.display()))?
+            }
+            None => ImpactParams::default(),
+        };
+        p.angle_deg = self.angle;
+        p.shape = Shape::from_name(&self.shape).with_context(|| {
+            format!(
+                "shape: unknown `{}`; expected one of {}",
+                self.shape,
+                grit_erosion::shapes::BUILTIN_NAMES.join(", ")
+            )
+        })?;
+        let set = |dst: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *dst = v;
+            }
+        };
+        set(&mut p.spacing_m, self.spacing_m);
+        set(&mut p.velocity_m_s, self.velocity_m_s);
+        set(&mut p.distribution_range_dg, self.distribution_range_dg);
+        set(&mut p.surface_width_dg, self.surface_width_dg);
+        set(&mut p.surface_depth_dg, self.surface_depth_dg);
+        set(&mut p.settle_fraction, self.settle_fraction);
+        if let Err(e) = p.validate() {
+            bail!("{}: {}", e.field, e.rule);
+        }
+        Ok(p)
+    }
+}
+
+/// Arguments of `grit sample`.
+#[derive(clap::Args)]
+pub struct SampleArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Number of impacts on the fresh surface.
+    #[arg(long, default_value_t = 60)]
+    impacts: u32,
+    /// Seed of the random aim points and orientations.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
     /// Worker threads of the engine (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -90,6 +134,23 @@ pub struct SampleArgs {
     /// Also write the JSON result (with every impact's details) to this file.
     #[arg(long, short)]
     out: Option<PathBuf>,
+}
+
+fn pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()?)
+}
+
+fn impact_bar(n: u32) -> anyhow::Result<indicatif::ProgressBar> {
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] {pos}/{len} impacts, {per_sec}, eta {eta} {msg}",
+        )?
+        .progress_chars("=> "),
+    );
+    Ok(bar)
 }
 
 #[derive(Serialize)]
@@ -111,50 +172,13 @@ struct SampleOutput<'a> {
 
 /// Runs one sample locally with a progress bar and prints its mass-loss series.
 pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
-    let mut p = match &a.scene {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading {}", path.display()))?;
-            serde_json::from_str(&text).with_context(|| format!("scene {}", path.display()))?
-        }
-        None => ImpactParams::default(),
-    };
-    p.angle_deg = a.angle;
-    p.shape = Shape::from_name(&a.shape).with_context(|| {
-        format!(
-            "shape: unknown `{}`; expected one of {}",
-            a.shape,
-            grit_erosion::shapes::BUILTIN_NAMES.join(", ")
-        )
-    })?;
-    let set = |dst: &mut f64, v: Option<f64>| {
-        if let Some(v) = v {
-            *dst = v;
-        }
-    };
-    set(&mut p.spacing_m, a.spacing_m);
-    set(&mut p.velocity_m_s, a.velocity_m_s);
-    set(&mut p.distribution_range_dg, a.distribution_range_dg);
-    set(&mut p.surface_width_dg, a.surface_width_dg);
-    set(&mut p.surface_depth_dg, a.surface_depth_dg);
-    set(&mut p.settle_fraction, a.settle_fraction);
     if a.impacts == 0 {
         bail!("impacts: must be at least 1");
     }
-    if let Err(e) = p.validate() {
-        bail!("{}: {}", e.field, e.rule);
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(a.threads.unwrap_or(0))
-        .build()?;
+    let p = a.scene.params()?;
+    let pool = pool(a.threads)?;
     let mut s = Sample::new(p.clone(), a.seed)?;
-    let bar = indicatif::ProgressBar::new(a.impacts as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] {pos}/{len} impacts, {per_sec}, eta {eta} {msg}",
-        )?
-        .progress_chars("=> "),
-    );
+    let bar = impact_bar(a.impacts)?;
     let t0 = Instant::now();
     for _ in 0..a.impacts {
         pool.install(|| s.run_next().map(|_| ()))?;
@@ -217,4 +241,90 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
         println!("wall time {:.1} s", t0.elapsed().as_secs_f64());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Arguments of `grit study`.
+#[derive(clap::Args)]
+pub struct StudyArgs {
+    #[command(subcommand)]
+    study: Study,
+}
+
+#[derive(clap::Subcommand)]
+enum Study {
+    /// Runs a sample and each of its impacts again, from the same surface, with a stricter end
+    /// criterion: mass loss and damage must not depend on when an impact ends.
+    Settle {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Number of impacts.
+        #[arg(long, default_value_t = 20)]
+        impacts: u32,
+        /// Seed of the sample.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// The stricter settle fraction.
+        #[arg(long, default_value_t = 0.002)]
+        strict_fraction: f64,
+        /// Worker threads of the engine (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print the rows as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Runs one of the checks of the scene's own choices (issue 3).
+pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
+    match a.study {
+        Study::Settle {
+            scene,
+            impacts,
+            seed,
+            strict_fraction,
+            threads,
+            json,
+        } => {
+            let p = scene.params()?;
+            let bar = impact_bar(impacts)?;
+            let rows = pool(threads)?.install(|| {
+                grit_erosion::studies::settle_study(&p, seed, impacts, strict_fraction, |_| {
+                    bar.inc(1)
+                })
+            })?;
+            bar.finish();
+            if json {
+                println!("{}", serde_json::to_string_pretty(&rows)?);
+                return Ok(ExitCode::SUCCESS);
+            }
+            println!(
+                "settle_fraction {} against {strict_fraction}",
+                p.settle_fraction
+            );
+            println!("impact  loss_kg_m   loss_strict  dD        dD_strict  t_s        t_strict_s");
+            for r in &rows {
+                println!(
+                    "{:>6}  {:>10.3e}  {:>10.3e}  {:>8.4}  {:>8.4}  {:>9.3e}  {:>9.3e}",
+                    r.impact,
+                    r.mass_loss_kg,
+                    r.mass_loss_strict_kg,
+                    r.damage_added,
+                    r.damage_added_strict,
+                    r.sim_time_s,
+                    r.sim_time_strict_s
+                );
+            }
+            let sum = |f: fn(&grit_erosion::studies::SettleRow) -> f64| -> f64 {
+                rows.iter().map(f).sum()
+            };
+            let (d, ds) = (sum(|r| r.damage_added), sum(|r| r.damage_added_strict));
+            let (m, ms) = (sum(|r| r.mass_loss_kg), sum(|r| r.mass_loss_strict_kg));
+            println!(
+                "total damage added {d:.4} vs {ds:.4} ({:+.2}%), mass loss {m:.3e} vs {ms:.3e} kg/m",
+                100.0 * (ds - d) / d.max(f64::MIN_POSITIVE)
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+    }
 }

@@ -9,6 +9,7 @@ pub mod fits;
 pub mod impact;
 pub mod sample;
 pub mod shapes;
+pub mod studies;
 
 pub use aggregate::{
     aggregate_campaign, aggregate_cell, AggregateError, CampaignResults, CellInput, CellResult,

@@ -7,7 +7,7 @@ use rand_core::{RngCore, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use crate::aggregate::Impact;
-use crate::impact::{run_impact, ImpactError, ImpactOutcome, ImpactParams};
+use crate::impact::{run_impact, GrainStart, ImpactError, ImpactOutcome, ImpactParams};
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
@@ -133,6 +133,12 @@ impl Sample {
         (unit(rng.next_u64()), unit(rng.next_u64()))
     }
 
+    /// The grain the next impact will fire (its random orientation and aim point).
+    pub fn next_grain(&self) -> Result<GrainStart, grit_sph::InputError> {
+        let (u_angle, u_aim) = self.draws(self.impacts_done());
+        self.params.grain_start(u_angle, u_aim)
+    }
+
     /// Runs the next impact; see `run_next_cancellable`.
     pub fn run_next(&mut self) -> Result<&ImpactRecord, SampleError> {
         self.run_next_cancellable(&|| false)
@@ -145,15 +151,11 @@ impl Sample {
         cancel: &dyn Fn() -> bool,
     ) -> Result<&ImpactRecord, SampleError> {
         let k = self.impacts_done();
-        let (u_angle, u_aim) = self.draws(k);
         let err = |source: ImpactError| SampleError::Impact {
             impact: k + 1,
             source,
         };
-        let grain = self
-            .params
-            .grain_start(u_angle, u_aim)
-            .map_err(|e| err(e.into()))?;
+        let grain = self.next_grain().map_err(|e| err(e.into()))?;
         let run = run_impact(&self.params, &self.surface, &grain, cancel).map_err(err)?;
         self.last_timers = run.timers;
         let outcome = run.outcome;
