@@ -25,6 +25,9 @@ enum Command {
     Sample(sample_cli::SampleArgs),
     /// Checks of the impact scene's own choices: `grit study settle`.
     Study(sample_cli::StudyArgs),
+    /// Job farm: serve, work, run, submit, status, results, cancel, retry-failed, bench.
+    #[command(flatten)]
+    Farm(grit_farm::cli::FarmCommand),
 }
 
 fn main() -> std::process::ExitCode {
@@ -34,6 +37,7 @@ fn main() -> std::process::ExitCode {
         Command::Shapes(a) => sample_cli::shapes(a),
         Command::Sample(a) => sample_cli::sample(a),
         Command::Study(a) => sample_cli::study(a),
+        Command::Farm(c) => grit_farm::cli::dispatch(c).map_err(anyhow::Error::from),
     };
     match result {
         Ok(code) => code,
