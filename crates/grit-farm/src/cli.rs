@@ -31,6 +31,13 @@ impl From<ClientError> for CliError {
 
 type CliResult = Result<ExitCode, CliError>;
 
+/// `println!` that ignores a closed stdout (`grit status --json | head`) instead of panicking.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 /// Subcommands of the job farm.
 #[derive(Subcommand, Debug)]
 pub enum FarmCommand {
@@ -364,7 +371,7 @@ pub fn dispatch(cmd: FarmCommand) -> CliResult {
             rt.block_on(async {
                 let id = parse_id(&a.id)?;
                 let r = a.remote.client()?.cancel(id).await?;
-                println!("cancelled {id}: {} jobs stopped", r.jobs);
+                say!("cancelled {id}: {} jobs stopped", r.jobs);
                 Ok(ExitCode::SUCCESS)
             })
         }
@@ -373,7 +380,7 @@ pub fn dispatch(cmd: FarmCommand) -> CliResult {
             rt.block_on(async {
                 let id = parse_id(&a.id)?;
                 let r = a.remote.client()?.retry_failed(id).await?;
-                println!("{id}: {} failed jobs queued again", r.jobs);
+                say!("{id}: {} failed jobs queued again", r.jobs);
                 Ok(ExitCode::SUCCESS)
             })
         }
@@ -424,7 +431,7 @@ async fn serve(a: ServeArgs) -> CliResult {
         .await
         .map_err(|e| CliError(format!("--listen {}: {e}", a.listen)))?;
     // Tests and scripts read the bound address (port 0 resolved) from this line.
-    println!("grit coordinator listening on http://{}", running.addr);
+    say!("grit coordinator listening on http://{}", running.addr);
     let _ = std::io::stdout().flush();
     tracing::info!(addr = %running.addr, db = %a.db.display(), "coordinator started");
     let stop = Stop::default();
@@ -492,7 +499,7 @@ async fn run(a: RunArgs) -> CliResult {
     );
     for c in &outcome.results.results.cells {
         let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
-        println!(
+        say!(
             "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}",
             c.angle_deg,
             c.shape,
@@ -529,7 +536,7 @@ async fn submit(a: SubmitArgs) -> CliResult {
         created.jobs,
         created.impacts_total
     );
-    println!("{}", created.id);
+    say!("{}", created.id);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -545,13 +552,13 @@ async fn status(a: StatusArgs) -> CliResult {
     let Some(id) = a.id.as_deref() else {
         let list = client.list().await?;
         if json {
-            println!(
+            say!(
                 "{}",
                 serde_json::to_string_pretty(&list).expect("serialises")
             );
         } else {
             for c in list {
-                println!(
+                say!(
                     "{}  {:<9}  {}/{} impacts  {}",
                     c.id,
                     format!("{:?}", c.state).to_lowercase(),
@@ -567,9 +574,9 @@ async fn status(a: StatusArgs) -> CliResult {
     if !a.watch {
         let s = client.status(id).await?;
         if json {
-            println!("{}", serde_json::to_string_pretty(&s).expect("serialises"));
+            say!("{}", serde_json::to_string_pretty(&s).expect("serialises"));
         } else {
-            println!(
+            say!(
                 "{}  {}  {}/{} impacts  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}",
                 s.id,
                 format!("{:?}", s.state).to_lowercase(),
@@ -584,9 +591,11 @@ async fn status(a: StatusArgs) -> CliResult {
                 fmt_eta(s.eta_s)
             );
             if let Some(e) = s.last_error {
-                println!(
+                say!(
                     "last error (cell {}, sample {}): {}",
-                    e.cell, e.sample, e.error
+                    e.cell,
+                    e.sample,
+                    e.error
                 );
             }
         }
@@ -633,9 +642,11 @@ async fn status(a: StatusArgs) -> CliResult {
                 b.finish();
             }
             if let Some(e) = s.last_error {
-                println!(
+                say!(
                     "last error (cell {}, sample {}): {}",
-                    e.cell, e.sample, e.error
+                    e.cell,
+                    e.sample,
+                    e.error
                 );
             }
             return Ok(ExitCode::SUCCESS);
@@ -653,7 +664,7 @@ async fn results(a: ResultsArgs) -> CliResult {
                 .map_err(|e| CliError(format!("{}: {e}", p.display())))?;
             eprintln!("results written to {}", p.display());
         }
-        None => println!("{}", serde_json::to_string_pretty(&v).expect("serialises")),
+        None => say!("{}", serde_json::to_string_pretty(&v).expect("serialises")),
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -672,7 +683,7 @@ async fn bench(a: BenchArgs) -> CliResult {
         .await
         .map_err(CliError)?;
     if json {
-        println!(
+        say!(
             "{}",
             serde_json::to_string_pretty(&rows).expect("serialises")
         );
