@@ -35,7 +35,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         (40, 40, 60, 40)
     };
     // Particles per cylinder radius, coarse to fine: the convergence of p0 needs three.
-    let hertz_n: &'static [usize] = if a.quick { &[20, 25, 35] } else { &[25, 35, 50] };
+    let hertz_n: &'static [usize] = if a.quick {
+        &[20, 25, 35]
+    } else {
+        &[25, 35, 50]
+    };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 5] = [
