@@ -168,6 +168,9 @@ struct SampleOutput<'a> {
     /// Least-squares slope of the last 20 points (dimensionless); null with fewer than 20.
     erosion_last20: Option<f64>,
     impacts: &'a [grit_erosion::ImpactRecord],
+    /// Why the sample stopped early, if it did; the series holds the impacts before it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
 }
 
 /// Runs one sample locally with a progress bar and prints its mass-loss series.
@@ -180,8 +183,13 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
     let mut s = Sample::new(p.clone(), a.seed)?;
     let bar = impact_bar(a.impacts)?;
     let t0 = Instant::now();
+    let mut failure = None;
     for _ in 0..a.impacts {
-        pool.install(|| s.run_next().map(|_| ()))?;
+        if let Err(e) = pool.install(|| s.run_next().map(|_| ())) {
+            // Keep what the finished impacts found: they are written below, then the error.
+            failure = Some(e);
+            break;
+        }
         bar.set_message(format!(
             "loss so far {:.3e} kg/m",
             s.records().iter().map(|r| r.mass_loss_kg).sum::<f64>()
@@ -190,6 +198,7 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
     }
     bar.finish();
     let impacts: Vec<_> = s.records().iter().map(|r| r.impact()).collect();
+    let error = failure.as_ref().map(|e| e.to_string());
     let cum = cumulative_series(&impacts);
     let out = SampleOutput {
         params: &p,
@@ -205,6 +214,7 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             .collect(),
         erosion_last20: sample_erosion(&cum, SLOPE_WINDOW),
         impacts: s.records(),
+        error,
     };
     if let Some(path) = &a.out {
         std::fs::write(path, serde_json::to_string_pretty(&out)?)
@@ -239,6 +249,12 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             None => println!("erosion: needs at least {SLOPE_WINDOW} impacts"),
         }
         println!("wall time {:.1} s", t0.elapsed().as_secs_f64());
+    }
+    if let Some(e) = failure {
+        return Err(anyhow::Error::from(e).context(format!(
+            "sample stopped after {} finished impacts",
+            s.impacts_done()
+        )));
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -246,10 +246,16 @@ pub struct GrainStart {
 /// What one impact did, beside the surface state it leaves.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImpactOutcome {
-    /// Surface mass removed as failed particles (kg/m).
+    /// Surface mass removed (kg/m): failed particles (D ≥ 1, eq. 19) plus fragments torn off
+    /// the surface (`detached_kg`).
     pub mass_loss_kg: f64,
-    /// Particles removed.
+    /// Failed particles removed.
     pub removed_particles: u32,
+    /// Mass of fragments no longer connected to the surface when the impact ends (kg/m): chips
+    /// whose particles did not reach D = 1 but left all the same.
+    pub detached_kg: f64,
+    /// Particles in those fragments.
+    pub detached_particles: u32,
     /// Simulated time of the impact (s).
     pub sim_time_s: f64,
     /// Steps taken.
@@ -326,6 +332,7 @@ pub fn run_impact(
     let half_width = 0.5 * params.surface_width_dg * dg;
     let t_max = MAX_TRANSITS * dg / params.velocity_m_s;
     let mut quiet = 0u32;
+    let (mut detached_kg, mut detached_particles) = (0.0, 0u32);
     let mut settled = false;
     while world.time() < t_max {
         if cancel() {
@@ -340,6 +347,16 @@ pub fn run_impact(
         let r = world.bodies()[g].rigid().expect("grain is rigid");
         let away = r.velocity_m_s.y > 0.0 || r.com_m.x.abs() > half_width + dg;
         if quiet >= SEPARATED_STEPS && away && quiet.is_multiple_of(10) {
+            // Flying fragments would hold the surface's kinetic energy up forever.
+            let keep = attached(&world, s, DETACH_LINK_DX * params.spacing_m);
+            if keep.iter().any(|k| !k) {
+                let p = world.particles();
+                for (i, _) in keep.iter().enumerate().filter(|(_, k)| !**k) {
+                    detached_kg += p.mass[i];
+                    detached_particles += 1;
+                }
+                world.remove_particles(&keep)?;
+            }
             let e = world.energy();
             let surface_ke = e.kinetic - grain_kinetic(&world, g);
             if surface_ke < params.settle_fraction * e0 {
@@ -350,8 +367,10 @@ pub fn run_impact(
     }
     let r = world.bodies()[g].rigid().expect("grain is rigid");
     let outcome = ImpactOutcome {
-        mass_loss_kg: world.bodies()[s].removed_mass_kg_m,
+        mass_loss_kg: world.bodies()[s].removed_mass_kg_m + detached_kg,
         removed_particles: world.bodies()[s].removed_particles as u32,
+        detached_kg,
+        detached_particles,
         sim_time_s: world.time(),
         steps: world.steps(),
         rebound_ratio: r.velocity_m_s.norm() / params.velocity_m_s,
@@ -363,6 +382,54 @@ pub fn run_impact(
         timers: world.timers().clone(),
         particles,
     })
+}
+
+/// Particles of the surface closer than this (in Δx) are connected; a lattice neighbour sits
+/// at 1 Δx, a diagonal one at 1.41 Δx.
+const DETACH_LINK_DX: f64 = 1.5;
+
+/// Keep-mask over all particles: false for surface particles in a fragment that no chain of
+/// neighbours closer than `link` joins to a fixed (kinematic) particle of body `s`.
+fn attached(world: &World, s: usize, link: f64) -> Vec<bool> {
+    let p = world.particles();
+    let n = p.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let inv = 1.0 / link;
+    let key = |x: Vector| ((x.x * inv).floor() as i64, (x.y * inv).floor() as i64);
+    let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    for i in (0..n).filter(|&i| p.body[i] as usize == s) {
+        cells.entry(key(p.pos[i])).or_default().push(i);
+    }
+    for i in (0..n).filter(|&i| p.body[i] as usize == s) {
+        let (cx, cy) = key(p.pos[i]);
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                for &j in cells.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| v) {
+                    if j > i && (p.pos[i] - p.pos[j]).norm() < link {
+                        let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                        if a != b {
+                            parent[a.max(b)] = a.min(b);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut anchored = vec![false; n];
+    for i in (0..n).filter(|&i| p.body[i] as usize == s && p.flags[i] & KINEMATIC != 0) {
+        let r = root(&mut parent, i);
+        anchored[r] = true;
+    }
+    (0..n)
+        .map(|i| p.body[i] as usize != s || anchored[root(&mut parent, i)])
+        .collect()
 }
 
 fn grain_kinetic(world: &World, g: usize) -> f64 {

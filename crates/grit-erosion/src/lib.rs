@@ -19,6 +19,6 @@ pub use fits::{
     fit_modified_oka, fit_oka, FitError, ModifiedOkaModel, OkaModel, ShapeExponents,
     ShapeReference, AISI304_HV_GPA,
 };
-pub use shapes::{Shape, ShapeError, ShapeInfo};
 pub use impact::{ImpactError, ImpactOutcome, ImpactParams};
 pub use sample::{ImpactRecord, Sample, SampleError};
+pub use shapes::{Shape, ShapeError, ShapeInfo};

@@ -11,7 +11,7 @@ use crate::impact::{run_impact, GrainStart, ImpactError, ImpactOutcome, ImpactPa
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
-pub const CHECKPOINT_VERSION: u32 = 1;
+pub const CHECKPOINT_VERSION: u32 = 2;
 
 /// One impact of a sample as reported to the farm and printed by `grit sample`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,12 +44,12 @@ impl ImpactRecord {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SampleError {
     /// An impact failed (bad input or an unstable simulation).
-    #[error("impact {impact}: {source}")]
+    #[error("impact {impact}: {error}")]
     Impact {
         /// 1-based impact number.
         impact: u32,
-        /// The engine's error.
-        source: ImpactError,
+        /// The engine's error (its text is in this error's own message).
+        error: ImpactError,
     },
     /// The scene parameters are invalid.
     #[error(transparent)]
@@ -151,9 +151,9 @@ impl Sample {
         cancel: &dyn Fn() -> bool,
     ) -> Result<&ImpactRecord, SampleError> {
         let k = self.impacts_done();
-        let err = |source: ImpactError| SampleError::Impact {
+        let err = |error: ImpactError| SampleError::Impact {
             impact: k + 1,
-            source,
+            error,
         };
         let grain = self.next_grain().map_err(|e| err(e.into()))?;
         let run = run_impact(&self.params, &self.surface, &grain, cancel).map_err(err)?;

@@ -47,10 +47,10 @@ pub fn settle_study(
     for k in 0..impacts {
         let grain = s.next_grain()?;
         let before: f64 = s.surface().damage.iter().sum();
-        let alt = run_impact(&strict, s.surface(), &grain, &|| false).map_err(|source| {
+        let alt = run_impact(&strict, s.surface(), &grain, &|| false).map_err(|error| {
             SampleError::Impact {
                 impact: k + 1,
-                source,
+                error,
             }
         })?;
         let alt_damage = damage_added(before, &alt.surface.damage, alt.outcome.mass_loss_kg, &s);

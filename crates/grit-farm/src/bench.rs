@@ -147,6 +147,8 @@ async fn client_loop(
             outcome: ImpactOutcome {
                 mass_loss_kg: 0.0,
                 removed_particles: 0,
+                detached_kg: 0.0,
+                detached_particles: 0,
                 sim_time_s: 0.0,
                 steps: 0,
                 rebound_ratio: 0.0,

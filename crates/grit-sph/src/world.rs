@@ -143,6 +143,12 @@ pub struct NumericalWork {
 /// than the work (small verification scenes ran slower on 2 threads than on 1 without it).
 const MIN_LEN: usize = 512;
 
+/// A deformable particle with fewer same-body neighbours inside the kernel support than this is
+/// a fragment torn off its body: its kernel sums no longer describe a continuum (the Shepard
+/// normalisation of eq. 9 divides by a near-empty sum and blows up), so it flies ballistically,
+/// keeping its stress, until it rejoins material. A particle inside a body has about 44.
+pub const MIN_SUPPORT_NEIGHBOURS: u32 = 6;
+
 /// Per-body constants the stages need, looked up by particle.
 #[derive(Debug, Clone, Copy, Default)]
 struct BodyConst {
@@ -717,6 +723,16 @@ impl World {
         self.nbrs_valid = false;
     }
 
+    /// Removes the particles with `keep[i] == false` (fragments a scene no longer follows),
+    /// keeping the order of the rest; removed mass is not booked as failed.
+    pub fn remove_particles(&mut self, keep: &[bool]) -> Result<(), InputError> {
+        if keep.len() != self.particles.len() {
+            return Err(InputError::new("keep", "needs one flag per particle"));
+        }
+        self.retain_particles(keep);
+        Ok(())
+    }
+
     fn retain_particles(&mut self, keep: &[bool]) {
         self.particles.retain(keep);
         for c in &mut self.contacts {
@@ -935,7 +951,7 @@ impl World {
             .with_min_len(MIN_LEN)
             .map(|i| {
                 let bi = p.body[i];
-                if !bc[bi as usize].deformable {
+                if !bc[bi as usize].deformable || pairs.pair_count[i] < MIN_SUPPORT_NEIGHBOURS {
                     return Matrix::zeros();
                 }
                 let vi = p.vel[i];
@@ -1061,6 +1077,9 @@ impl World {
                 // Kinematic particles follow their prescribed motion: their force is never used.
                 if !c.deformable || p.flags[i] & KINEMATIC != 0 {
                     return (Vector::zeros(), 0.0);
+                }
+                if cache.pair_count[i] < MIN_SUPPORT_NEIGHBOURS {
+                    return (g, 0.0);
                 }
                 let vi = p.vel[i];
                 let voli = p.mass[i] / p.rho[i];
