@@ -160,3 +160,27 @@ fn bad_scene_names_the_field() {
     let unknown = serde_json::from_str::<ImpactParams>(r#"{"angle": 45}"#).unwrap_err();
     assert!(unknown.to_string().contains("angle"), "{unknown}");
 }
+
+#[test]
+fn one_impact_is_bitwise_the_same_on_1_and_2_threads() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            // Fine enough that every stage splits into several rayon tasks.
+            let params = ImpactParams {
+                spacing_m: 16e-6,
+                surface_width_dg: 3.0,
+                ..ImpactParams::paper(45.0, Shape::Square)
+            };
+            let mut s = Sample::new(params, 21).unwrap();
+            s.run_next().unwrap();
+            (bits(s.surface()), record_bits(s.records()))
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert!(one.0.len() > 1000);
+    assert_eq!(one, two);
+}
