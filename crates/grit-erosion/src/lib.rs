@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod aggregate;
+pub mod bench;
 pub mod campaign;
 pub mod fits;
 pub mod impact;

@@ -79,9 +79,15 @@ pub struct Sample {
     surface: Particles,
     records: Vec<ImpactRecord>,
     last_timers: Timers,
+    last_particles: usize,
 }
 
 impl Sample {
+    /// Particles (surface and grain) at the start of the last impact run by this process.
+    pub fn last_particles(&self) -> usize {
+        self.last_particles
+    }
+
     /// Per-stage wall time of the last impact run by this process (for benchmarks).
     pub fn last_timers(&self) -> &Timers {
         &self.last_timers
@@ -96,6 +102,7 @@ impl Sample {
             surface,
             records: Vec::new(),
             last_timers: Timers::default(),
+            last_particles: 0,
         })
     }
 
@@ -158,6 +165,7 @@ impl Sample {
         let grain = self.next_grain().map_err(|e| err(e.into()))?;
         let run = run_impact(&self.params, &self.surface, &grain, cancel).map_err(err)?;
         self.last_timers = run.timers;
+        self.last_particles = run.particles;
         let outcome = run.outcome;
         self.surface = run.surface;
         self.records.push(ImpactRecord {
@@ -212,6 +220,7 @@ impl Sample {
             surface: c.surface,
             records: c.records,
             last_timers: Timers::default(),
+            last_particles: 0,
         })
     }
 }

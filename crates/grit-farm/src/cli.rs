@@ -278,6 +278,28 @@ enum BenchWhat {
         #[arg(long)]
         json: bool,
     },
+    /// One impact of the reference scene (hexagon, 45°, 100 m/s, AISI 304, 8 µm) timed on 1
+    /// thread and on N threads from the same surface: particle-steps per second and stages.
+    Impact {
+        /// Impact angle (degrees).
+        #[arg(long, default_value_t = 45.0)]
+        angle: f64,
+        /// Particle spacing Δx (m); 8e-6 is the reference, coarser ones are quicker.
+        #[arg(long, default_value_t = 8e-6)]
+        spacing_m: f64,
+        /// Impacts the surface takes before the timed one (the second scene: 30).
+        #[arg(long, default_value_t = 0)]
+        after: u32,
+        /// Seed of the sample.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Threads of the timed run (1 is always timed too).
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
+        /// Print the figures as JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn init_tracing(default: &str) {
@@ -669,13 +691,82 @@ async fn results(a: ResultsArgs) -> CliResult {
     Ok(ExitCode::SUCCESS)
 }
 
+/// `grit bench impact`: synchronous, the engine runs on rayon pools of its own.
+fn bench_impact(
+    angle: f64,
+    spacing_m: f64,
+    after: u32,
+    seed: u64,
+    threads: usize,
+    json: bool,
+) -> CliResult {
+    use grit_erosion::{ImpactParams, Sample, Shape};
+    if threads == 0 {
+        return Err(CliError("--threads: must be at least 1".into()));
+    }
+    let params = ImpactParams {
+        spacing_m,
+        ..ImpactParams::paper(angle, Shape::Hexagon)
+    };
+    params
+        .validate()
+        .map_err(|e| CliError(format!("{}: {}", e.field, e.rule)))?;
+    let mut s = Sample::new(params, seed).map_err(|e| CliError(e.to_string()))?;
+    for k in 0..after {
+        eprintln!("preparing the surface: impact {} of {after}", k + 1);
+        s.run_next().map_err(|e| CliError(e.to_string()))?;
+    }
+    let b = grit_erosion::bench::impact(&s, threads).map_err(|e| CliError(e.to_string()))?;
+    if json {
+        say!("{}", serde_json::to_string_pretty(&b).expect("serialises"));
+        return Ok(ExitCode::SUCCESS);
+    }
+    say!("scene: hexagon {angle} deg, 100 m/s, AISI 304, spacing {spacing_m:e} m, surface after {after} impacts");
+    say!("particles                 {}", b.particles);
+    say!("steps                     {}", b.steps);
+    say!("wall ({} threads)          {:.2} s", b.threads, b.wall_s);
+    say!("wall (1 thread)           {:.2} s", b.wall_1_thread_s);
+    say!("particle-steps/s          {:.3e}", b.particle_steps_per_s);
+    say!(
+        "particle-steps/s/thread   {:.3e}",
+        b.particle_steps_per_s_per_thread
+    );
+    if let Some(x) = b.speedup_1_to_2 {
+        say!("speed-up 1 -> 2 threads   {x:.2}");
+    }
+    let total: f64 = b.stages.values().sum();
+    for (k, v) in &b.stages {
+        say!(
+            "  {k:<14} {v:>8.3} s  {:>5.1}%",
+            100.0 * v / total.max(1e-12)
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 async fn bench(a: BenchArgs) -> CliResult {
-    let BenchWhat::Farm {
-        clients,
-        seconds,
-        dir,
-        json,
-    } = a.what;
+    let (clients, seconds, dir, json) = match a.what {
+        BenchWhat::Farm {
+            clients,
+            seconds,
+            dir,
+            json,
+        } => (clients, seconds, dir, json),
+        BenchWhat::Impact {
+            angle,
+            spacing_m,
+            after,
+            seed,
+            threads,
+            json,
+        } => {
+            return tokio::task::spawn_blocking(move || {
+                bench_impact(angle, spacing_m, after, seed, threads, json)
+            })
+            .await
+            .map_err(|e| CliError(format!("benchmark thread: {e}")))?
+        }
+    };
     if clients.is_empty() || clients.contains(&0) {
         return Err(CliError("--clients: every count must be at least 1".into()));
     }

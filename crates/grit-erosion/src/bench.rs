@@ -1,0 +1,75 @@
+//! The impact benchmark of issue 5: one impact of a sample, timed on 1 thread and on N threads
+//! from the same surface state, with the engine's per-stage timers.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::sample::{Sample, SampleError};
+
+/// Figures of one timed impact, as `grit bench impact --json` prints them (names kept stable).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImpactBench {
+    /// Particles in the scene at the start of the impact (surface and grain).
+    pub particles: usize,
+    /// Steps the impact took.
+    pub steps: u64,
+    /// Wall time of the impact on `threads` threads (s).
+    pub wall_s: f64,
+    /// particles × steps / wall time, on `threads` threads.
+    pub particle_steps_per_s: f64,
+    /// The same divided by the thread count.
+    pub particle_steps_per_s_per_thread: f64,
+    /// Threads of the timed run.
+    pub threads: usize,
+    /// Wall time on 1 thread over wall time on 2 threads, same impact, same run.
+    pub speedup_1_to_2: Option<f64>,
+    /// Wall time on 1 thread (s).
+    pub wall_1_thread_s: f64,
+    /// Seconds per engine stage on `threads` threads.
+    pub stages: BTreeMap<String, f64>,
+    /// Impacts the surface had taken before the timed one.
+    pub surface_impacts: u32,
+}
+
+/// Times the next impact of `sample` on 1 thread and on `threads` threads, each from a copy of
+/// the same state, so both runs do bitwise the same work (the engine is deterministic).
+pub fn impact(sample: &Sample, threads: usize) -> Result<ImpactBench, SampleError> {
+    let timed = |n: usize| -> Result<(f64, Sample), SampleError> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| SampleError::Checkpoint(format!("thread pool: {e}")))?;
+        let mut s = sample.clone();
+        let t0 = Instant::now();
+        pool.install(|| s.run_next().map(|_| ()))?;
+        Ok((t0.elapsed().as_secs_f64(), s))
+    };
+    let (wall1, one) = timed(1)?;
+    let (wall, many) = if threads == 1 {
+        (wall1, one)
+    } else {
+        timed(threads)?
+    };
+    let r = many.records().last().expect("one impact ran");
+    let particles = many.last_particles();
+    let ps = particles as f64 * r.outcome.steps as f64;
+    Ok(ImpactBench {
+        particles,
+        steps: r.outcome.steps,
+        wall_s: wall,
+        particle_steps_per_s: ps / wall,
+        particle_steps_per_s_per_thread: ps / wall / threads as f64,
+        threads,
+        speedup_1_to_2: (threads == 2).then(|| wall1 / wall),
+        wall_1_thread_s: wall1,
+        stages: many
+            .last_timers()
+            .breakdown()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect(),
+        surface_impacts: sample.impacts_done(),
+    })
+}
