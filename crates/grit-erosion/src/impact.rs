@@ -83,16 +83,7 @@ impl ImpactParams {
 
     /// Checks every field; the error names the field and the rule.
     pub fn validate(&self) -> Result<(), InputError> {
-        let positive = |field: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(InputError::new(
-                    field,
-                    format!("must be a finite number > 0, got {v}"),
-                ))
-            }
-        };
+        let positive = |f: &str, v: f64| InputError::require_positive(f, v);
         if !(self.angle_deg > 0.0 && self.angle_deg <= 90.0) {
             return Err(InputError::new(
                 "angle_deg",

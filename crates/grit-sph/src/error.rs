@@ -20,6 +20,19 @@ impl InputError {
             rule: rule.into(),
         }
     }
+
+    /// Checks the rule most physical inputs share: a finite number > 0 (DESIGN.md: errors name
+    /// the field and the rule).
+    pub fn require_positive(field: impl Into<String>, v: f64) -> Result<(), InputError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(InputError::new(
+                field,
+                format!("must be a finite number > 0, got {v}"),
+            ))
+        }
+    }
 }
 
 /// A simulation that went unstable (DESIGN.md "never fails silently").

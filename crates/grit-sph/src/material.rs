@@ -130,16 +130,8 @@ impl Material {
 
     /// Checks every field is physical; the error names the field and the rule.
     pub fn validate(&self) -> Result<(), InputError> {
-        let pos = |field: &str, v: f64| -> Result<(), InputError> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(InputError::new(
-                    format!("material.{field}"),
-                    format!("must be a finite number > 0, got {v}"),
-                ))
-            }
-        };
+        let pos =
+            |field: &str, v: f64| InputError::require_positive(format!("material.{field}"), v);
         let fin = |field: &str, v: f64| -> Result<(), InputError> {
             if v.is_finite() {
                 Ok(())

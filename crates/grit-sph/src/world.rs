@@ -65,16 +65,7 @@ impl Default for Settings {
 impl Settings {
     /// Checks that every setting is usable; the error names the field.
     pub fn validate(&self) -> Result<(), InputError> {
-        let pos = |f: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(InputError::new(
-                    f,
-                    format!("must be a finite number > 0, got {v}"),
-                ))
-            }
-        };
+        let pos = |f: &str, v: f64| InputError::require_positive(f, v);
         pos("spacing_m", self.spacing_m)?;
         pos("h_over_dx", self.h_over_dx)?;
         pos("cfl", self.cfl)?;
@@ -171,6 +162,8 @@ struct Scratch {
     /// read by the rates and the forces, so each pair's kernel is evaluated once per step.
     pairs: Vec<Pair>,
     pair_count: Vec<u32>,
+    /// Particle volumes m/ρ of this step, computed once instead of once per pair.
+    vol: Vec<f64>,
     shepard: Vec<f64>,
     lcorr: Vec<Matrix>,
     gradv: Vec<Matrix>,
@@ -886,6 +879,15 @@ impl World {
         let k = &self.kernel;
         let w0 = k.w(0.0);
         let n = p.len();
+        let mut vol = std::mem::take(&mut self.scratch.vol);
+        vol.clear();
+        vol.par_extend(
+            p.mass
+                .par_iter()
+                .zip(&p.rho)
+                .with_min_len(MIN_LEN)
+                .map(|(m, r)| m / r),
+        );
         let mut buf = std::mem::take(&mut self.scratch.pairs);
         // Rows are overwritten before they are read: grow, never clear (a memset per step).
         if buf.len() < nl.list.len() {
@@ -916,7 +918,7 @@ impl World {
                     if pair.w == 0.0 && pair.dw == 0.0 {
                         continue;
                     }
-                    let vj = p.mass[pair.j] / p.rho[pair.j];
+                    let vj = vol[pair.j];
                     g += vj * pair.w;
                     if pair.r > 0.0 {
                         let grad = pair.xij * (pair.dw / pair.r);
@@ -930,6 +932,7 @@ impl World {
             .collect();
         let s = &mut self.scratch;
         s.pairs = buf;
+        s.vol = vol;
         s.shepard.clear();
         s.lcorr.clear();
         s.pair_count.clear();
@@ -960,8 +963,7 @@ impl World {
                     if r == 0.0 {
                         continue;
                     }
-                    let vj = p.mass[j] / p.rho[j];
-                    gv += outer(p.vel[j] - vi, xij * (dw / r)) * vj;
+                    gv += outer(p.vel[j] - vi, xij * (dw / r)) * pairs.vol[j];
                 }
                 gv * lc[i].transpose()
             })
@@ -1093,7 +1095,7 @@ impl World {
                     a += (sig[i] + sig[j]) * grad * p.mass[j];
                     if alpha > 0.0 && w > 0.0 {
                         let e = xij / r;
-                        let volj = p.mass[j] / p.rho[j];
+                        let volj = cache.vol[j];
                         let cij = alpha * voli * volj * w / (r * r);
                         // Viscous part: velocity error against the mean velocity gradient.
                         let vij = vi - p.vel[j];
@@ -1461,15 +1463,21 @@ fn body_pairs<'a>(
     i: usize,
 ) -> impl Iterator<Item = Pair> + 'a {
     let (bi, xi) = (p.body[i], p.pos[i]);
+    let r2max = k.radius() * k.radius();
     nl.of(i)
         .iter()
         .map(|&j| j as usize)
         .filter(move |&j| p.body[j] == bi)
-        .map(move |j| {
+        .filter_map(move |j| {
             let xij = xi - p.pos[j];
-            let r = xij.norm();
+            let r2 = xij.norm_squared();
+            // The lists reach a skin beyond the support; those pairs would add exact zeros.
+            if r2 >= r2max {
+                return None;
+            }
+            let r = r2.sqrt();
             let (w, dw) = k.w_dw(r);
-            Pair { j, xij, r, w, dw }
+            Some(Pair { j, xij, r, w, dw })
         })
 }
 
