@@ -24,13 +24,21 @@ pub const SPEED: f64 = 20.0;
 pub struct History {
     /// Sample times (s).
     pub t: Vec<f64>,
-    /// Total energy (kinetic + elastic + contact springs) (J/m).
+    /// Total energy (kinetic + elastic + contact springs) over its initial value.
     pub energy: Vec<f64>,
+    /// Work of the density filter so far over the initial energy (negative: removed).
+    pub filter_work: Vec<f64>,
+    /// Work of the hourglass forces so far over the initial energy (negative: removed).
+    pub hourglass_work: Vec<f64>,
     /// Relative momentum drift |p − p0| / |p0|.
     pub momentum_drift: Vec<f64>,
     /// Whether the disc touched the block at the sample.
     pub in_contact: Vec<bool>,
-    /// Numerical work at the end.
+    /// Largest E/E0 over every step (the samples above are every tenth step).
+    pub peak: f64,
+    /// E/E0 at the first step after the disc has left the block.
+    pub at_release: f64,
+    /// Numerical work at the end over the initial energy.
     pub work: NumericalWork,
 }
 
@@ -83,7 +91,11 @@ pub fn simulate_until(
     let mut w = scene(n, settings);
     let e0 = w.energy().total();
     let p0 = w.momentum();
-    let mut h = History::default();
+    let mut h = History {
+        peak: 1.0,
+        at_release: f64::NAN,
+        ..History::default()
+    };
     let mut touched = false;
     let mut left_at = None;
     let t_max = t_end.unwrap_or(40.0 * RADIUS / SPEED);
@@ -91,12 +103,20 @@ pub fn simulate_until(
         w.step()?;
         let touching = w.contact_forces().iter().any(|f| f.norm() > 0.0);
         touched |= touching;
+        // Every step: the energy swings within a few steps while particles ring on the springs,
+        // and a sample every tenth step would miss the peak.
+        let e = w.energy().total() / e0;
+        h.peak = h.peak.max(e);
         if touched && !touching && left_at.is_none() {
             left_at = Some(w.time());
+            h.at_release = e;
         }
         if w.steps().is_multiple_of(10) {
+            let nw = w.numerical_work();
             h.t.push(w.time());
-            h.energy.push(w.energy().total() / e0);
+            h.energy.push(e);
+            h.filter_work.push(nw.density_filter / e0);
+            h.hourglass_work.push(nw.hourglass / e0);
             h.momentum_drift
                 .push((w.momentum() - p0).norm() / p0.norm());
             h.in_contact.push(touching);
@@ -110,6 +130,8 @@ pub fn simulate_until(
     h.work = w.numerical_work();
     h.work.hourglass /= e0;
     h.work.density_filter /= e0;
+    h.work.contact_damping /= e0;
+    h.work.plastic /= e0;
     Ok(h)
 }
 
@@ -117,10 +139,8 @@ pub fn simulate_until(
 pub fn run(n: usize) -> Result<CaseReport, SimError> {
     let h = simulate(n, Settings::default())?;
     let res = format!("{n} particles per block side");
-    let max_e = h.energy.iter().cloned().fold(f64::MIN, f64::max);
-    let last_contact = h.in_contact.iter().rposition(|&c| c).unwrap_or(0);
-    let after = h.energy.get(last_contact + 1..).unwrap_or(&[]);
-    let e_after = after.last().copied().unwrap_or(f64::NAN);
+    let max_e = h.peak;
+    let e_after = h.energy.last().copied().unwrap_or(f64::NAN);
     let drift = h.momentum_drift.iter().cloned().fold(0.0, f64::max);
     let mut rep = CaseReport::default();
     rep.rows.push(Row {
@@ -130,6 +150,7 @@ pub fn run(n: usize) -> Result<CaseReport, SimError> {
         reference: 0.0,
         error_rel: drift,
         pass: drift <= 1e-8,
+        expected_fail: false,
         note: "max |p - p0| / |p0| over the run; bound 1e-8".into(),
     });
     rep.rows.push(Row {
@@ -139,7 +160,8 @@ pub fn run(n: usize) -> Result<CaseReport, SimError> {
         reference: 1.0,
         error_rel: (max_e - 1.0).max(0.0),
         pass: max_e <= 1.01,
-        note: "max E/E0 (kinetic + elastic + contact springs); bound 1.01".into(),
+        expected_fail: false,
+        note: "max E/E0 over every step (kinetic + elastic + contact springs); bound 1.01".into(),
     });
     rep.rows.push(Row {
         case: "elastic_impact_energy_after".into(),
@@ -148,22 +170,43 @@ pub fn run(n: usize) -> Result<CaseReport, SimError> {
         reference: 1.0,
         error_rel: (e_after - 1.0).abs(),
         pass: (e_after - 1.0).abs() <= 0.05,
+        expected_fail: false,
         note: format!(
-            "E/E0 after contact; bound 5%; hourglass work {:.2e} E0, density filter {:.2e} E0",
-            h.work.hourglass, h.work.density_filter
+            "E/E0 two disc radii of flight after release; bound 5%; E/E0 at release {:.4}; \
+             work over the run: density filter {:.4} E0, hourglass {:.4} E0",
+            h.at_release, h.work.density_filter, h.work.hourglass
         ),
     });
+    let budget: Vec<f64> = h
+        .energy
+        .iter()
+        .zip(&h.filter_work)
+        .zip(&h.hourglass_work)
+        .map(|((e, f), g)| e - f - g)
+        .collect();
+    let series = |label: &str, y: &[f64]| Series {
+        label: label.into(),
+        x: h.t.clone(),
+        y: y.to_vec(),
+        reference: false,
+    };
     rep.charts.push(Chart {
         name: "elastic_impact_energy".into(),
-        title: "Elastic impact: energy and momentum".into(),
+        title: format!("Elastic impact: energy, {n} particles per block side"),
         x_label: "time (s)".into(),
         y_label: "E / E0".into(),
-        series: vec![Series {
-            label: "E/E0".into(),
-            x: h.t.clone(),
-            y: h.energy.clone(),
-            reference: false,
-        }],
+        series: vec![
+            series("E/E0 (kinetic + elastic + contact)", &h.energy),
+            series("E/E0 + removed by filter and hourglass", &budget),
+            series("density filter work / E0", &h.filter_work),
+            series("hourglass work / E0", &h.hourglass_work),
+            Series {
+                label: "E0".into(),
+                x: vec![0.0, h.t.last().copied().unwrap_or(0.0)],
+                y: vec![1.0, 1.0],
+                reference: true,
+            },
+        ],
     });
     Ok(rep)
 }

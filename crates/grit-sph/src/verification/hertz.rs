@@ -318,6 +318,7 @@ pub fn run(n_radius: &[usize]) -> Result<CaseReport, SimError> {
             reference: peak_pressure(last.load_n_m, e_star),
             error_rel: worst,
             pass: shrinks && (!finest || worst <= P0_BOUND),
+            expected_fail: false,
             note: format!(
                 "p0 (Pa) at Q = {:.2} MN/m, reached at t = {:.3} ms; error = max relative error of p0 over Q = {} MN/m ({}), E* = E/(1-nu^2); bound: smaller than at the coarser spacing, and {:.0}% at the finest",
                 last.load_n_m / 1e6,
@@ -339,6 +340,7 @@ pub fn run(n_radius: &[usize]) -> Result<CaseReport, SimError> {
             reference: 0.0,
             error_rel: prms,
             pass: prms <= PRESSURE_RMS_BOUND,
+            expected_fail: false,
             note: format!(
                 "RMS(p - eq. 32) / p0 over surface particles with |x| <= 1.5 a at Q = {:.2} MN/m; regression bound {PRESSURE_RMS_BOUND}",
                 last.load_n_m / 1e6
@@ -352,6 +354,7 @@ pub fn run(n_radius: &[usize]) -> Result<CaseReport, SimError> {
             reference: 0.0,
             error_rel: arms,
             pass: arms <= AXIS_RMS_BOUND,
+            expected_fail: false,
             note: format!(
                 "RMS(sigma - eq. 33) / p0 over sxx, szz, syy of axis particles down to z = {AXIS_DEPTH} a at Q = {:.2} MN/m; regression bound {AXIS_RMS_BOUND}",
                 last.load_n_m / 1e6
@@ -417,10 +420,13 @@ pub fn run(n_radius: &[usize]) -> Result<CaseReport, SimError> {
         value: last.peak_pa,
         reference: peak_pressure(last.load_n_m, e_star),
         error_rel: worst,
-        pass: worst > first_err,
+        pass: worst <= P0_BOUND,
+        // A demonstration: the seed's filter smooths the peak of the contact pressure away.
+        expected_fail: true,
         note: format!(
-            "as hertz_peak_pressure with the density filter (eq. 12) every 40 steps; errors {}; pass = larger than without the filter ({:.1}%), the reason this case runs without it",
+            "as hertz_peak_pressure with the density filter (eq. 12) every 40 steps; errors {}; expected to fail the {:.0}% bound (without the filter {:.1}%): the reason this case runs without it",
             errs.iter().map(|e| format!("{:.1}%", e * 100.0)).collect::<Vec<_>>().join("/"),
+            P0_BOUND * 100.0,
             first_err * 100.0
         ),
     });

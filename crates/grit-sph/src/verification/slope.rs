@@ -184,6 +184,9 @@ pub fn run(n_side: usize) -> Result<CaseReport, SimError> {
                 reference,
                 error_rel: err,
                 pass: err <= 0.02,
+                // The penetration contact's artificial roughness brakes a sliding slider (the
+                // seed's Fig. 2b): those rows exist to fail. A sticking one passes either way.
+                expected_fail: model == ContactModel::Penetration && !sticks,
                 note: if sticks {
                     "speed at 1.5 s (m/s); error = max |v| / (g t / 2) after 0.1 s, bound 2%".into()
                 } else {
