@@ -162,7 +162,8 @@ struct Scratch {
     /// read by the rates and the forces, so each pair's kernel is evaluated once per step.
     pairs: Vec<Pair>,
     pair_count: Vec<u32>,
-    /// Particle volumes m/ρ of this step, computed once instead of once per pair.
+    /// Particle volumes m/ρ at the kernel sums, computed once instead of once per pair; valid
+    /// until the stress stage updates ρ.
     vol: Vec<f64>,
     shepard: Vec<f64>,
     lcorr: Vec<Matrix>,
@@ -1095,7 +1096,9 @@ impl World {
                     a += (sig[i] + sig[j]) * grad * p.mass[j];
                     if alpha > 0.0 && w > 0.0 {
                         let e = xij / r;
-                        let volj = cache.vol[j];
+                        // Not cache.vol: the stress stage has moved ρ since (continuity), and
+                        // both volumes must be the same step's for a symmetric pair force.
+                        let volj = p.mass[j] / p.rho[j];
                         let cij = alpha * voli * volj * w / (r * r);
                         // Viscous part: velocity error against the mean velocity gradient.
                         let vij = vi - p.vel[j];
