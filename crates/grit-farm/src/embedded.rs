@@ -127,6 +127,11 @@ pub async fn run(
         )
         .expect("valid template"),
     );
+    // Without a terminal (a log file, a batch job) the bar draws nothing: say the same in a
+    // plain line now and then, so long campaigns still show progress.
+    let plain = opts.progress && !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let started = std::time::Instant::now();
+    let mut last_line: Option<std::time::Instant> = None;
     let state = loop {
         let status = store.status(created.id).await.map_err(|e| e.to_string())?;
         bar.set_position(status.impacts_done);
@@ -153,6 +158,16 @@ pub async fn run(
                 String::new()
             }
         ));
+        if plain && last_line.is_none_or(|t| t.elapsed() >= Duration::from_secs(30)) {
+            last_line = Some(std::time::Instant::now());
+            eprintln!(
+                "[{:>6.0} s] {}/{} impacts  {}",
+                started.elapsed().as_secs_f64(),
+                status.impacts_done,
+                status.impacts_total,
+                bar.message()
+            );
+        }
         if status.state.is_final() {
             if let Some(e) = &status.last_error {
                 bar.println(format!(
