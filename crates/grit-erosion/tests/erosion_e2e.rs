@@ -32,7 +32,9 @@ fn coarse_sample_incubates_then_erodes() {
         "mass loss does not grow after impact {}",
         first + 1
     );
-    assert!(cum.windows(2).all(|w| w[1].mass_loss_kg >= w[0].mass_loss_kg));
+    assert!(cum
+        .windows(2)
+        .all(|w| w[1].mass_loss_kg >= w[0].mass_loss_kg));
     let e = sample_erosion(&cum, SLOPE_WINDOW).unwrap();
     assert!(e.is_finite() && e > 0.0, "erosion {e}");
     // Every impact ended by the criterion, not by the time limit.
