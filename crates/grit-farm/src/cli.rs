@@ -530,6 +530,16 @@ async fn run(a: RunArgs) -> CliResult {
             fmt(c.erosion_std)
         );
     }
+    // Charts beside results.json (`grit plot` draws the same); a chart that fails leaves
+    // the results, already written, standing.
+    match grit_plot::plot_file(&outcome.results_path, &a.out) {
+        Ok(r) => eprintln!(
+            "{} chart files (PNG, SVG) in {}",
+            r.files.len(),
+            a.out.display()
+        ),
+        Err(e) => eprintln!("charts not written: {e}"),
+    }
     Ok(match outcome.state {
         CampaignState::Done => ExitCode::SUCCESS,
         _ => ExitCode::from(1),

@@ -1,0 +1,747 @@
+//! The five chart kinds. Masses are shown in g (grains) and mg (surface) per metre of
+//! depth, since the engine is 2D and its masses are per metre; erosion is shown in mg of
+//! surface lost per g of grains (10⁻³ of the dimensionless erosion), so the slope of the
+//! mass-loss chart reads directly as erosion.
+
+use grit_erosion::aggregate::cumulative_series;
+use grit_erosion::{CampaignResults, CellResult, Impact};
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+
+use crate::analysis::{series_label, Analysis, Series, HV_GPA};
+use crate::draw::{
+    colour, de, error_bar, file_safe, save, top, with_notes, DrawResult, Figure, FONT,
+};
+use crate::{PlotError, PlotInput, Report};
+
+/// Erosion (dimensionless) to mg per g.
+const MG_PER_G: f64 = 1e3;
+/// kg to g, for grain mass.
+const G_PER_KG: f64 = 1e3;
+/// kg to mg, for mass loss.
+const MG_PER_KG: f64 = 1e6;
+const EROSION_AXIS: &str = "erosion (mg surface lost per g of grains)";
+/// Angles at which model curves are evaluated: (0°, 90°] in half degrees.
+fn curve_angles() -> impl Iterator<Item = f64> {
+    (1..=180).map(|k| 0.5 * k as f64)
+}
+
+fn cell_label(c: &CellResult) -> String {
+    format!("{}°, {}", c.angle_deg, series_label(&c.shape, &c.swept))
+}
+
+/// Lower end of a value axis: 0, or 10 % below the lowest value when that is negative.
+fn bottom(values: impl Iterator<Item = f64>) -> f64 {
+    let m = values.filter(|v| v.is_finite()).fold(0.0, f64::min);
+    1.1 * m
+}
+
+fn legend_box<'a, DB: DrawingBackend + 'a, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    pos: SeriesLabelPosition,
+) -> DrawResult
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+{
+    chart
+        .configure_series_labels()
+        .position(pos)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.4))
+        .label_font((FONT, 14))
+        .draw()
+        .map_err(de)
+}
+
+fn line_key(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], style)
+}
+
+fn dash_key(
+    style: ShapeStyle,
+    dash: i32,
+    gap: i32,
+) -> impl Fn((i32, i32)) -> DashedPathElement<std::vec::IntoIter<(i32, i32)>, i32> {
+    move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 22, y)], dash, gap, style)
+}
+
+// ---------------------------------------------------------------- mass loss (Figs. 8, 10b)
+
+struct MassLoss<'a> {
+    cell: &'a CellResult,
+    /// Each sample's cumulative (grain g/m, loss mg/m); empty without raw series.
+    samples: Vec<Vec<(f64, f64)>>,
+    window: usize,
+    notes: Vec<String>,
+}
+
+impl Figure for MassLoss<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let area = with_notes(root, &self.notes)?;
+        let c = self.cell;
+        let col = colour(0);
+        let mean: Vec<(f64, f64, Option<f64>)> = c
+            .mean_series
+            .iter()
+            .map(|p| {
+                (
+                    p.grain_mass_kg * G_PER_KG,
+                    p.mass_loss_kg * MG_PER_KG,
+                    p.mass_loss_std_kg.map(|s| s * MG_PER_KG),
+                )
+            })
+            .collect();
+        let all = || self.samples.iter().flatten().copied();
+        let xmax = top(all().map(|p| p.0).chain(mean.iter().map(|p| p.0)));
+        let ymax = top(all()
+            .map(|p| p.1)
+            .chain(mean.iter().map(|p| p.1 + p.2.unwrap_or(0.0))));
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                format!(
+                    "Mass loss against grain mass: {} ({} samples)",
+                    cell_label(c),
+                    c.samples_reported
+                ),
+                (FONT, 22),
+            )
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(0.0..xmax, 0.0..ymax)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("cumulative grain mass (g per m of depth)")
+            .y_desc("cumulative surface mass loss (mg per m of depth)")
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 17))
+            .draw()
+            .map_err(de)?;
+        if !self.samples.is_empty() {
+            let faint = col.mix(0.45).stroke_width(1);
+            for (k, s) in self.samples.iter().enumerate() {
+                let drawn = chart
+                    .draw_series(LineSeries::new(s.iter().copied(), faint))
+                    .map_err(de)?;
+                if k == 0 {
+                    drawn
+                        .label(format!("each sample ({})", self.samples.len()))
+                        .legend(line_key(faint));
+                }
+            }
+        } else if mean.iter().any(|p| p.2.is_some()) {
+            let band: Vec<(f64, f64)> = mean
+                .iter()
+                .map(|p| (p.0, p.1 + p.2.unwrap_or(0.0)))
+                .chain(
+                    mean.iter()
+                        .rev()
+                        .map(|p| (p.0, (p.1 - p.2.unwrap_or(0.0)).max(0.0))),
+                )
+                .collect();
+            let fill = col.mix(0.2).filled();
+            chart
+                .draw_series(std::iter::once(Polygon::new(band, fill)))
+                .map_err(de)?
+                .label("mean ± 1 std over samples")
+                .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 22, y + 6)], fill));
+        }
+        let bold = col.stroke_width(3);
+        chart
+            .draw_series(LineSeries::new(mean.iter().map(|p| (p.0, p.1)), bold))
+            .map_err(de)?
+            .label("mean of the samples")
+            .legend(line_key(bold));
+        if mean.len() >= self.window && self.window >= 2 {
+            let tail = &mean[mean.len() - self.window..];
+            let marks = BLACK.filled();
+            chart
+                .draw_series(tail.iter().map(|p| Circle::new((p.0, p.1), 3, marks)))
+                .map_err(de)?
+                .label(format!("last {} points (erosion window)", self.window))
+                .legend(move |(x, y)| Circle::new((x + 11, y), 3, marks));
+            if let Some(e) = c.erosion_mean {
+                // The cell's erosion is the mean of the samples' slopes; drawn through the
+                // centroid of the mean series' window it shows that slope in place.
+                let n = tail.len() as f64;
+                let xc = tail.iter().map(|p| p.0).sum::<f64>() / n;
+                let yc = tail.iter().map(|p| p.1).sum::<f64>() / n;
+                let slope = e * MG_PER_G;
+                let (x0, x1) = (tail[0].0, tail[tail.len() - 1].0);
+                let x0 = x0 - 0.15 * (x1 - x0);
+                let line = BLACK.stroke_width(2);
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        [x0, x1].map(|x| (x, yc + slope * (x - xc))),
+                        8,
+                        5,
+                        line,
+                    ))
+                    .map_err(de)?
+                    .label(format!(
+                        "last-{} fit: slope = erosion = {:.3} mg/g (mean of sample slopes)",
+                        self.window, slope
+                    ))
+                    .legend(dash_key(line, 6, 4));
+            }
+        }
+        legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
+    }
+}
+
+/// One mass-loss chart per cell with impacts: faint samples (or a ±std band), bold mean,
+/// the erosion window and its fit line.
+pub fn mass_loss(
+    input: &PlotInput,
+    out: &std::path::Path,
+    report: &mut Report,
+) -> Result<(), PlotError> {
+    let results = &input.results;
+    for (i, c) in results.cells.iter().enumerate() {
+        if c.mean_series.is_empty() {
+            report.notes.push(format!(
+                "cell {i} ({}): no impacts, no mass-loss chart",
+                cell_label(c)
+            ));
+            continue;
+        }
+        let samples: Vec<Vec<(f64, f64)>> = input
+            .raw
+            .iter()
+            .flatten()
+            .filter(|r| r.cell as usize == i && !r.impacts.is_empty())
+            .map(|r| {
+                let mut impacts = r.impacts.clone();
+                impacts.sort_by_key(|m| m.impact);
+                let impacts: Vec<Impact> = impacts
+                    .iter()
+                    .map(|m| Impact {
+                        grain_mass_kg: m.grain_mass_kg,
+                        mass_loss_kg: m.mass_loss_kg,
+                    })
+                    .collect();
+                cumulative_series(&impacts)
+                    .iter()
+                    .map(|p| (p.grain_mass_kg * G_PER_KG, p.mass_loss_kg * MG_PER_KG))
+                    .collect()
+            })
+            .collect();
+        let mut notes = Vec::new();
+        if input.raw.is_none() {
+            notes.push(
+                "No per-impact series in this file (grit run --raw or grit results --raw \
+                 give them): the band is ±1 std of the samples' cumulative mass loss."
+                    .to_string(),
+            );
+        }
+        if c.samples_without_slope > 0 {
+            notes.push(format!(
+                "{} of {} samples have fewer than {} impacts and no slope.",
+                c.samples_without_slope, c.samples_reported, results.slope_window
+            ));
+        }
+        if c.erosion_mean.is_none() {
+            notes.push("No sample has a slope yet: no erosion, no fit line.".to_string());
+        }
+        if c.partial {
+            notes.push(format!(
+                "Partial: {} of {} samples reported.",
+                c.samples_reported, c.samples_planned
+            ));
+        }
+        let fig = MassLoss {
+            cell: c,
+            samples,
+            window: results.slope_window,
+            notes,
+        };
+        let stem = format!(
+            "mass_loss_c{i:02}_{}deg_{}",
+            c.angle_deg,
+            file_safe(&series_label(&c.shape, &c.swept))
+        );
+        report.files.extend(save(&fig, out, &stem)?);
+    }
+    Ok(())
+}
+
+// --------------------------------------------------- erosion against angle (Figs. 11a, 12a)
+
+struct Angle<'a> {
+    an: &'a Analysis,
+    notes: Vec<String>,
+}
+
+/// A model curve: (angle in degrees, erosion in mg/g).
+type Curve = Vec<(f64, f64)>;
+
+/// The fitted and the published-exponent Oka curves of a series; empty when absent.
+fn oka_points(s: &Series) -> (Curve, Curve) {
+    let curve = |m: &grit_erosion::OkaModel| -> Curve {
+        curve_angles()
+            .map(|a| (a, m.erosion(a) * MG_PER_G))
+            .collect()
+    };
+    (
+        s.oka
+            .fit
+            .as_ref()
+            .map(|f| curve(&f.model))
+            .unwrap_or_default(),
+        s.oka.published.as_ref().map(curve).unwrap_or_default(),
+    )
+}
+
+impl Figure for Angle<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let area = with_notes(root, &self.notes)?;
+        let curves: Vec<_> = self.an.series.iter().map(oka_points).collect();
+        let bars = || {
+            self.an.series.iter().flat_map(|s| {
+                s.points.iter().flat_map(|p| {
+                    let d = p.std.unwrap_or(0.0);
+                    [(p.mean + d) * MG_PER_G, (p.mean - d) * MG_PER_G]
+                })
+            })
+        };
+        let model = || {
+            curves
+                .iter()
+                .flat_map(|(f, p)| f.iter().chain(p).map(|q| q.1))
+        };
+        let ymax = top(bars().chain(model()));
+        let ymin = bottom(bars());
+        let mut chart = ChartBuilder::on(&area)
+            .caption("Erosion against impact angle, with Oka's model", (FONT, 22))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(0.0..95.0, ymin..ymax)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("impact angle α (degrees from the surface)")
+            .x_labels(20)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_desc(EROSION_AXIS)
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 17))
+            .draw()
+            .map_err(de)?;
+        for (i, (s, (fit, published))) in self.an.series.iter().zip(&curves).enumerate() {
+            let c = colour(i);
+            let bar = c.stroke_width(1);
+            for p in &s.points {
+                if let Some(d) = p.std {
+                    let (lo, hi) = ((p.mean - d) * MG_PER_G, (p.mean + d) * MG_PER_G);
+                    chart
+                        .draw_series(error_bar(p.angle_deg, lo, hi, 1.2, bar))
+                        .map_err(de)?;
+                }
+            }
+            let line = c.stroke_width(2);
+            chart
+                .draw_series(
+                    LineSeries::new(
+                        s.points.iter().map(|p| (p.angle_deg, p.mean * MG_PER_G)),
+                        line,
+                    )
+                    .point_size(5),
+                )
+                .map_err(de)?
+                .label(format!("{}: simulated, bars ±1 std over samples", s.label))
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (22, 0)], line)
+                        + Circle::new((11, 0), 4, c.filled())
+                });
+            if !fit.is_empty() {
+                chart
+                    .draw_series(DashedLineSeries::new(fit.clone(), 9, 5, line))
+                    .map_err(de)?
+                    .label(format!("{}: Oka fit (n1, n2, E90 fitted)", s.label))
+                    .legend(dash_key(line, 7, 4));
+            }
+            if !published.is_empty() {
+                chart
+                    .draw_series(DashedLineSeries::new(published.clone(), 2, 4, line))
+                    .map_err(de)?
+                    .label(format!("{}: Oka silica exponents × simulated E90", s.label))
+                    .legend(dash_key(line, 2, 3));
+            }
+        }
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// Erosion against angle per series, with error bars and both Oka curves.
+pub fn erosion_vs_angle(
+    an: &Analysis,
+    out: &std::path::Path,
+    report: &mut Report,
+) -> Result<(), PlotError> {
+    if an.series.is_empty() {
+        report.notes.push(
+            "no cell has an erosion yet (every sample is short of the slope window): \
+             no angle charts"
+                .into(),
+        );
+        return Ok(());
+    }
+    let fig = Angle {
+        an,
+        notes: an
+            .notes
+            .iter()
+            .filter(|n| !n.starts_with("modified Oka") && !n.starts_with("no modified"))
+            .cloned()
+            .collect(),
+    };
+    report.files.extend(save(&fig, out, "erosion_vs_angle")?);
+    report.notes.extend(an.notes.iter().cloned());
+    Ok(())
+}
+
+// ------------------------------------------------------------ normalised at 45° (Fig. 12b)
+
+struct Normalised<'a> {
+    an: &'a Analysis,
+    /// (series index, erosion at 45°).
+    shown: Vec<(usize, f64)>,
+    notes: Vec<String>,
+}
+
+impl Figure for Normalised<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let area = with_notes(root, &self.notes)?;
+        let reference = grit_erosion::OkaModel::silica(HV_GPA, 1.0);
+        let g45 = reference.g(45.0);
+        let oka: Vec<(f64, f64)> = curve_angles().map(|a| (a, reference.g(a) / g45)).collect();
+        let scaled = |i: usize, e45: f64| {
+            self.an.series[i].points.iter().map(move |p| {
+                let d = p.std.unwrap_or(0.0);
+                (p.angle_deg, p.mean / e45, d / e45, p.std.is_some())
+            })
+        };
+        let values = || {
+            self.shown
+                .iter()
+                .flat_map(|&(i, e)| scaled(i, e).flat_map(|p| [p.1 + p.2, p.1 - p.2]))
+        };
+        let ymax = top(values().chain(oka.iter().map(|p| p.1)));
+        let ymin = bottom(values());
+        let mut chart = ChartBuilder::on(&area)
+            .caption("Erosion normalised by its value at 45°", (FONT, 22))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(0.0..95.0, ymin..ymax)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("impact angle α (degrees from the surface)")
+            .x_labels(20)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_desc("erosion / erosion at 45° (dimensionless)")
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 17))
+            .draw()
+            .map_err(de)?;
+        let grey = BLACK.mix(0.6).stroke_width(2);
+        chart
+            .draw_series(DashedLineSeries::new(oka, 9, 5, grey))
+            .map_err(de)?
+            .label("Oka, silica exponents: g(α)/g(45°)")
+            .legend(dash_key(grey, 7, 4));
+        for &(i, e45) in &self.shown {
+            let c = colour(i);
+            for (a, m, d, has) in scaled(i, e45) {
+                if has {
+                    chart
+                        .draw_series(error_bar(a, m - d, m + d, 1.2, c.stroke_width(1)))
+                        .map_err(de)?;
+                }
+            }
+            let line = c.stroke_width(2);
+            chart
+                .draw_series(
+                    LineSeries::new(scaled(i, e45).map(|p| (p.0, p.1)), line).point_size(5),
+                )
+                .map_err(de)?
+                .label(format!(
+                    "{}: simulated, bars ±1 std / E(45°)",
+                    self.an.series[i].label
+                ))
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (22, 0)], line)
+                        + Circle::new((11, 0), 4, c.filled())
+                });
+        }
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// Erosion divided by the erosion at 45°, per series that has a positive 45° value.
+pub fn normalised(
+    an: &Analysis,
+    out: &std::path::Path,
+    report: &mut Report,
+) -> Result<(), PlotError> {
+    let mut shown = Vec::new();
+    let mut notes = Vec::new();
+    for (i, s) in an.series.iter().enumerate() {
+        match s.points.iter().find(|p| p.angle_deg == 45.0) {
+            Some(p) if p.mean > 0.0 => shown.push((i, p.mean)),
+            Some(_) => notes.push(format!("{}: erosion at 45° is zero, not drawn", s.label)),
+            None => notes.push(format!("{}: no 45° cell, not drawn", s.label)),
+        }
+    }
+    if shown.is_empty() {
+        if !an.series.is_empty() {
+            report
+                .notes
+                .push("no series has a positive erosion at 45°: no normalised chart".into());
+        }
+        return Ok(());
+    }
+    let fig = Normalised {
+        an,
+        shown,
+        notes: notes.clone(),
+    };
+    report
+        .files
+        .extend(save(&fig, out, "erosion_normalised_45deg")?);
+    report.notes.extend(notes);
+    Ok(())
+}
+
+// -------------------------------------------------------------- modified Oka (Fig. 14)
+
+struct ModifiedChart<'a> {
+    an: &'a Analysis,
+    notes: Vec<String>,
+}
+
+impl Figure for ModifiedChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let area = with_notes(root, &self.notes)?;
+        let Ok(m) = &self.an.modified else {
+            return Err("no modified-Oka model".into());
+        };
+        let curve = |model: &grit_erosion::ModifiedOkaModel, (e, an): (f64, f64)| -> Curve {
+            curve_angles()
+                .map(|a| (a, model.erosion(a, e, an) * MG_PER_G))
+                .collect()
+        };
+        let seeds: Vec<_> = m.factors.iter().map(|&f| curve(&m.seed, f)).collect();
+        let fits: Vec<_> = match &m.fitted {
+            Ok(model) => m.factors.iter().map(|&f| curve(model, f)).collect(),
+            Err(_) => Vec::new(),
+        };
+        let points = || {
+            m.series.iter().flat_map(|&i| {
+                self.an.series[i].points.iter().flat_map(|p| {
+                    let d = p.std.unwrap_or(0.0);
+                    [(p.mean + d) * MG_PER_G, (p.mean - d) * MG_PER_G]
+                })
+            })
+        };
+        let ymax = top(points().chain(seeds.iter().chain(&fits).flatten().map(|p| p.1)));
+        let ymin = bottom(points());
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                "Shape-modified Oka model (hexagon reference) against the simulation",
+                (FONT, 22),
+            )
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(0.0..95.0, ymin..ymax)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("impact angle α (degrees from the surface)")
+            .x_labels(20)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_desc(EROSION_AXIS)
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 17))
+            .draw()
+            .map_err(de)?;
+        for (k, &i) in m.series.iter().enumerate() {
+            let s = &self.an.series[i];
+            let c = colour(i);
+            for p in &s.points {
+                if let Some(d) = p.std {
+                    let (lo, hi) = ((p.mean - d) * MG_PER_G, (p.mean + d) * MG_PER_G);
+                    chart
+                        .draw_series(error_bar(p.angle_deg, lo, hi, 1.2, c.stroke_width(1)))
+                        .map_err(de)?;
+                }
+            }
+            chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|p| Circle::new((p.angle_deg, p.mean * MG_PER_G), 5, c.filled())),
+                )
+                .map_err(de)?
+                .label(format!("{}: simulated, bars ±1 std", s.label))
+                .legend(move |(x, y)| Circle::new((x + 11, y), 5, c.filled()));
+            let line = c.stroke_width(2);
+            if let Some(f) = fits.get(k) {
+                chart
+                    .draw_series(LineSeries::new(f.iter().copied(), line))
+                    .map_err(de)?
+                    .label(format!("{}: modified Oka, fitted n3..n6", s.label))
+                    .legend(line_key(line));
+            }
+            chart
+                .draw_series(DashedLineSeries::new(seeds[k].iter().copied(), 9, 5, line))
+                .map_err(de)?
+                .label(format!("{}: modified Oka, seed's n3..n6", s.label))
+                .legend(dash_key(line, 7, 4));
+        }
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// The shape-modified Oka model against the simulated points, when there is one.
+pub fn modified_oka(
+    an: &Analysis,
+    out: &std::path::Path,
+    report: &mut Report,
+) -> Result<(), PlotError> {
+    if an.modified.is_err() {
+        return Ok(());
+    }
+    let notes = an
+        .notes
+        .iter()
+        .filter(|n| n.starts_with("modified Oka") || n.contains("Oka fit n1"))
+        .cloned()
+        .collect();
+    let fig = ModifiedChart { an, notes };
+    report.files.extend(save(&fig, out, "modified_oka")?);
+    Ok(())
+}
+
+// ----------------------------------------------------------------- convergence (Fig. 10a)
+
+struct Convergence<'a> {
+    results: &'a CampaignResults,
+}
+
+impl Figure for Convergence<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let area = with_notes(root, &[])?;
+        let cells = || {
+            self.results
+                .cells
+                .iter()
+                .filter(|c| !c.convergence.is_empty())
+        };
+        let values = || {
+            cells().flat_map(|c| {
+                c.convergence.iter().flat_map(|p| {
+                    let d = p.erosion_std.unwrap_or(0.0);
+                    [
+                        (p.erosion_mean + d) * MG_PER_G,
+                        (p.erosion_mean - d) * MG_PER_G,
+                    ]
+                })
+            })
+        };
+        let nmax = cells()
+            .flat_map(|c| c.convergence.iter().map(|p| p.samples))
+            .max()
+            .unwrap_or(1);
+        let (ymin, ymax) = (bottom(values()), top(values()));
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                "Convergence of erosion with the number of samples",
+                (FONT, 22),
+            )
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(0.5..(nmax as f64 + 0.5), ymin..ymax)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("number of samples k (the first k with a slope)")
+            .y_desc(EROSION_AXIS)
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 17))
+            .x_labels((nmax + 1).min(26))
+            // Sample counts are whole numbers: ticks between them stay blank.
+            .x_label_formatter(&|v| {
+                if (v - v.round()).abs() < 1e-9 {
+                    format!("{v:.0}")
+                } else {
+                    String::new()
+                }
+            })
+            .draw()
+            .map_err(de)?;
+        for (i, c) in cells().enumerate() {
+            let col = colour(i);
+            let bar = col.mix(0.5).stroke_width(1);
+            for p in &c.convergence {
+                if let Some(d) = p.erosion_std {
+                    let m = p.erosion_mean;
+                    chart
+                        .draw_series(error_bar(
+                            p.samples as f64,
+                            (m - d) * MG_PER_G,
+                            (m + d) * MG_PER_G,
+                            0.01 * nmax as f64,
+                            bar,
+                        ))
+                        .map_err(de)?;
+                }
+            }
+            let line = col.stroke_width(2);
+            chart
+                .draw_series(
+                    LineSeries::new(
+                        c.convergence
+                            .iter()
+                            .map(|p| (p.samples as f64, p.erosion_mean * MG_PER_G)),
+                        line,
+                    )
+                    .point_size(4),
+                )
+                .map_err(de)?
+                .label(format!(
+                    "{}: mean of the first k, bars ±1 std",
+                    cell_label(c)
+                ))
+                .legend(line_key(line));
+        }
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// Running erosion mean (±std) against the number of samples, one line per cell.
+pub fn convergence(
+    results: &CampaignResults,
+    out: &std::path::Path,
+    report: &mut Report,
+) -> Result<(), PlotError> {
+    if results.cells.iter().all(|c| c.convergence.is_empty()) {
+        report
+            .notes
+            .push("no cell has a sample with a slope: no convergence chart".into());
+        return Ok(());
+    }
+    report
+        .files
+        .extend(save(&Convergence { results }, out, "convergence")?);
+    Ok(())
+}

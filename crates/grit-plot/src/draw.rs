@@ -1,0 +1,128 @@
+//! Drawing shared by the charts: one figure drawn on both backends, a strip of notes under
+//! the plot, colours, error bars and axis ranges.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::PlotError;
+
+/// Size of every chart, pixels.
+pub const SIZE: (u32, u32) = (1100, 750);
+/// Font family of all text (registered by `register_fonts`).
+pub const FONT: &str = "sans-serif";
+
+/// Ten distinguishable colours (the usual "tab10" hues).
+pub const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// Colour number `i`, cycling.
+pub fn colour(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Errors of plotters as text (their types differ per backend).
+pub type DrawResult = Result<(), String>;
+
+/// Turns any plotters error into text.
+pub fn de(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// A chart that can be drawn on any backend.
+pub trait Figure {
+    /// Draws the whole chart on `root`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
+}
+
+/// Draws `fig` as `out/stem.png` and `out/stem.svg`; returns both paths.
+pub fn save(fig: &impl Figure, out: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
+    let png = out.join(format!("{stem}.png"));
+    let svg = out.join(format!("{stem}.svg"));
+    let failed = |path: &Path| {
+        let path = path.to_path_buf();
+        move |message| PlotError::Draw { path, message }
+    };
+    {
+        let root = BitMapBackend::new(&png, SIZE).into_drawing_area();
+        fig.draw(&root).map_err(failed(&png))?;
+        root.present().map_err(de).map_err(failed(&png))?;
+    }
+    {
+        let root = SVGBackend::new(&svg, SIZE).into_drawing_area();
+        fig.draw(&root).map_err(failed(&svg))?;
+        root.present().map_err(de).map_err(failed(&svg))?;
+    }
+    Ok(vec![png, svg])
+}
+
+/// Fills `root` white and splits off a strip at the bottom with `notes`, one per line;
+/// returns the area above for the plot.
+pub fn with_notes<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    notes: &[String],
+) -> Result<DrawingArea<DB, Shift>, String> {
+    root.fill(&WHITE).map_err(de)?;
+    if notes.is_empty() {
+        return Ok(root.clone());
+    }
+    let line = 19;
+    let (plot, strip) = root.split_vertically(SIZE.1 as i32 - line * notes.len() as i32 - 10);
+    let grey = BLACK.mix(0.8);
+    let style = TextStyle::from((FONT, 14).into_font()).color(&grey);
+    for (i, n) in notes.iter().enumerate() {
+        strip
+            .draw_text(n, &style, (14, 2 + line * i as i32))
+            .map_err(de)?;
+    }
+    Ok(plot)
+}
+
+/// Upper end of a value axis from 0: 10 % above the largest value, 1 when all are ≤ 0.
+pub fn top(values: impl Iterator<Item = f64>) -> f64 {
+    let m = values.filter(|v| v.is_finite()).fold(0.0, f64::max);
+    if m > 0.0 {
+        1.1 * m
+    } else {
+        1.0
+    }
+}
+
+/// Vertical error bar from `lo` to `hi` at `x`, with caps `cap` wide (data units).
+pub fn error_bar(
+    x: f64,
+    lo: f64,
+    hi: f64,
+    cap: f64,
+    style: ShapeStyle,
+) -> [PathElement<(f64, f64)>; 3] {
+    [
+        PathElement::new(vec![(x, lo), (x, hi)], style),
+        PathElement::new(vec![(x - cap, lo), (x + cap, lo)], style),
+        PathElement::new(vec![(x - cap, hi), (x + cap, hi)], style),
+    ]
+}
+
+/// A file-name-safe version of `s`.
+pub fn file_safe(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,137 @@
+//! The results JSON: grit-erosion's `CampaignResults` with the farm's optional `raw` array.
+
+use std::path::Path;
+
+use grit_erosion::CampaignResults;
+use serde::Deserialize;
+use serde_json::Value;
+
+use crate::PlotError;
+
+/// One impact of a raw series; the farm's `ImpactRecord` carries more, which is ignored.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct RawImpact {
+    /// 1-based impact number within the sample (0 when absent).
+    #[serde(default)]
+    pub impact: u32,
+    /// Mass of the grain, kg (per metre of depth in 2D).
+    pub grain_mass_kg: f64,
+    /// Surface mass removed by the impact, kg (per metre of depth in 2D).
+    pub mass_loss_kg: f64,
+}
+
+/// One sample's per-impact series (`raw[]` of `grit run --raw` or `grit results --raw`).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct RawSeries {
+    /// Index of the cell in `cells`.
+    pub cell: u32,
+    /// Index of the sample within its cell.
+    pub sample: u32,
+    /// Impacts in the order they hit the surface.
+    pub impacts: Vec<RawImpact>,
+}
+
+/// A results file ready to plot.
+#[derive(Debug, Clone)]
+pub struct PlotInput {
+    /// The aggregated results.
+    pub results: CampaignResults,
+    /// Per-impact series of every sample, when the file has them.
+    pub raw: Option<Vec<RawSeries>>,
+}
+
+/// Reads and checks a results JSON file.
+pub fn load(path: &Path) -> Result<PlotInput, PlotError> {
+    let text = std::fs::read_to_string(path).map_err(|error| PlotError::Read {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    parse(&text).map_err(|e| PlotError::Input(format!("{}: {e}", path.display())))
+}
+
+/// Parses and checks results JSON text.
+pub fn parse(text: &str) -> Result<PlotInput, PlotError> {
+    let bad = |m: String| PlotError::Input(m);
+    // Parse to a value first, so a syntax error names its line and column and a file of
+    // the wrong kind is told apart from a broken one.
+    let mut value: Value =
+        serde_json::from_str(text).map_err(|e| bad(format!("not valid JSON: {e}")))?;
+    let Some(obj) = value.as_object_mut() else {
+        return Err(bad(
+            "expected a JSON object with `cells` (the results of grit run or grit results)".into(),
+        ));
+    };
+    match obj.get("cells") {
+        None => {
+            return Err(bad(
+                "no `cells` array: not a results file (grit run writes OUT/results.json; \
+                 grit results ID -o FILE fetches one)"
+                    .into(),
+            ))
+        }
+        Some(Value::Array(a)) if a.is_empty() => {
+            return Err(bad("`cells` is empty: nothing to plot".into()))
+        }
+        Some(Value::Array(_)) => {}
+        Some(_) => return Err(bad("`cells` is not an array".into())),
+    }
+    let raw = obj.remove("raw");
+    let results: CampaignResults = serde_json::from_value(value)
+        .map_err(|e| bad(format!("not a results file grit can read: {e}")))?;
+    let raw: Option<Vec<RawSeries>> = match raw {
+        None | Some(Value::Null) => None,
+        Some(r) => Some(serde_json::from_value(r).map_err(|e| bad(format!("raw: {e}")))?),
+    };
+    if let Some(raw) = &raw {
+        for (i, r) in raw.iter().enumerate() {
+            if r.cell as usize >= results.cells.len() {
+                return Err(bad(format!(
+                    "raw[{i}].cell: {} but there are {} cells",
+                    r.cell,
+                    results.cells.len()
+                )));
+            }
+        }
+    }
+    Ok(PlotInput { results, raw })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CELL: &str = r#"{"angle_deg": 45.0, "shape": "hexagon", "partial": false,
+        "samples": 0, "samples_planned": 1, "samples_reported": 0, "samples_without_slope": 0,
+        "impacts_planned": 20, "erosion_mean": null, "erosion_std": null, "erosion_sem": null,
+        "per_sample": [], "mean_series": [], "convergence": []}"#;
+
+    fn err(text: &str) -> String {
+        parse(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn wrong_files_are_told_apart() {
+        assert!(err("{").starts_with("not valid JSON"));
+        assert!(err("[1, 2]").starts_with("expected a JSON object"));
+        assert!(err(r#"{"partial": false}"#).starts_with("no `cells` array"));
+        assert!(err(r#"{"cells": []}"#).contains("empty"));
+        assert!(err(r#"{"cells": 3}"#).contains("not an array"));
+        assert!(err(r#"{"cells": [{}]}"#).starts_with("not a results file"));
+    }
+
+    #[test]
+    fn raw_is_optional_and_checked() {
+        let base = format!(r#"{{"partial": false, "slope_window": 20, "cells": [{CELL}]"#);
+        let p = parse(&format!("{base}}}")).unwrap();
+        assert!(p.raw.is_none());
+        let with = format!(
+            r#"{base}, "raw": [{{"cell": 0, "sample": 0, "seed": 9, "state": "done",
+            "impacts": [{{"impact": 1, "grain_mass_kg": 1e-4, "mass_loss_kg": 0.0,
+            "aim_x_m": 0.0}}]}}]}}"#
+        );
+        let p = parse(&with).unwrap();
+        assert_eq!(p.raw.unwrap()[0].impacts[0].grain_mass_kg, 1e-4);
+        let stray = with.replace(r#""cell": 0"#, r#""cell": 4"#);
+        assert!(err(&stray).starts_with("raw[0].cell"));
+    }
+}

@@ -1,0 +1,260 @@
+//! `grit plot` on results files writes every chart their data allow, as PNGs that decode and
+//! are not blank and SVGs with text; bad input ends with a clear error, never a panic.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use grit_erosion::fits::{ModifiedOkaModel, OkaModel, ShapeExponents, ShapeReference};
+use grit_erosion::{
+    aggregate_campaign, CellInput, Impact, ImpactOutcome, ImpactRecord, SampleInput, Shape,
+    SLOPE_WINDOW,
+};
+
+fn grit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_grit"))
+        .args(args)
+        .output()
+        .expect("run grit")
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// Runs `grit plot` on `results` into a fresh folder; returns the folder and stdout.
+fn plot(results: &Path) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = grit(&[
+        "plot",
+        results.to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "grit plot failed: {}\n{stdout}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (dir, stdout)
+}
+
+fn stems(dir: &Path) -> BTreeSet<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect()
+}
+
+/// Every PNG decodes at the chart size and its plot area holds more than a background:
+/// several distinct colours. Every SVG is an SVG with text (axis labels, legend).
+fn check_images(dir: &Path) -> usize {
+    let mut n = 0;
+    for name in stems(dir) {
+        let path = dir.join(&name);
+        if name.ends_with(".png") {
+            let img = image::open(&path)
+                .unwrap_or_else(|e| panic!("{name} does not decode: {e}"))
+                .to_rgb8();
+            assert_eq!(img.dimensions(), (1100, 750), "{name}");
+            let mut colours = BTreeSet::new();
+            for y in 100..500 {
+                for x in 120..1050 {
+                    colours.insert(img.get_pixel(x, y).0);
+                }
+            }
+            assert!(
+                colours.len() > 3,
+                "{name}: plot area has {} colours",
+                colours.len()
+            );
+            n += 1;
+        } else if name.ends_with(".svg") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(text.contains("<svg") && text.contains("<text"), "{name}");
+            assert!(text.contains("</svg>"), "{name} is cut short");
+        }
+    }
+    n
+}
+
+fn assert_has(files: &BTreeSet<String>, stem: &str) {
+    for ext in ["png", "svg"] {
+        let f = format!("{stem}.{ext}");
+        assert!(files.contains(&f), "{f} missing from {files:?}");
+    }
+}
+
+#[test]
+fn plot_writes_every_chart_for_the_quick_results() {
+    let (dir, stdout) = plot(&data("quick-results.json"));
+    let files = stems(dir.path());
+    for stem in [
+        "mass_loss_c00_45deg_hexagon",
+        "mass_loss_c01_90deg_hexagon",
+        "erosion_vs_angle",
+        "erosion_normalised_45deg",
+        "convergence",
+    ] {
+        assert_has(&files, stem);
+    }
+    // One shape, two angles: neither Oka's fit (3 angles) nor the modified model.
+    assert!(!files.contains("modified_oka.png"), "{files:?}");
+    assert!(stdout.contains("no Oka fit"), "{stdout}");
+    assert!(stdout.contains("no modified-Oka chart"), "{stdout}");
+    assert_eq!(check_images(dir.path()), 5);
+    assert!(stdout.contains("hexagon") && stdout.contains("2.952e-3 ± 3.413e-4"));
+    assert!(stdout.contains("wrote 10 files:"), "{stdout}");
+}
+
+/// Deterministic noise in [−1, 1] from a fixed LCG.
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// A results file with raw series: three shapes at six angles, 3 samples of 30 impacts,
+/// eroding at the seed's modified-Oka rates with noise after 5 impacts of incubation.
+fn synthetic_results() -> serde_json::Value {
+    let model = ModifiedOkaModel {
+        oka: OkaModel::silica(1.8, 2e-3),
+        reference: ShapeReference::HEXAGON,
+        exponents: ShapeExponents::SEED,
+    };
+    let mut rng = Lcg(7);
+    let (mut cells, mut raw) = (Vec::new(), Vec::new());
+    for shape in [Shape::Octagon, Shape::Hexagon, Shape::Square] {
+        let (an, e) = shape.factors().unwrap();
+        for angle in [15.0, 30.0, 45.0, 60.0, 75.0, 90.0] {
+            let cell = cells.len() as u32;
+            let mut samples = Vec::new();
+            for sample in 0..3u32 {
+                let records: Vec<ImpactRecord> = (1..=30u32)
+                    .map(|k| {
+                        let grain = 1.2e-4 * (1.0 + 0.05 * rng.next());
+                        let rate = model.erosion(angle, e, an) * (1.0 + 0.5 * rng.next());
+                        let loss = if k > 5 { grain * rate } else { 0.0 };
+                        ImpactRecord {
+                            impact: k,
+                            grain_mass_kg: grain,
+                            mass_loss_kg: loss,
+                            orientation_rad: rng.next(),
+                            aim_x_m: 1e-5 * rng.next(),
+                            outcome: ImpactOutcome {
+                                mass_loss_kg: loss,
+                                removed_particles: 0,
+                                detached_kg: 0.0,
+                                detached_particles: 0,
+                                sim_time_s: 1e-6,
+                                steps: 1000,
+                                rebound_ratio: 0.5,
+                                settled: true,
+                            },
+                        }
+                    })
+                    .collect();
+                samples.push(SampleInput {
+                    sample,
+                    impacts: records
+                        .iter()
+                        .map(ImpactRecord::impact)
+                        .collect::<Vec<Impact>>(),
+                });
+                raw.push(serde_json::json!({
+                    "cell": cell, "sample": sample, "seed": 100 + sample, "state": "done",
+                    "impacts": records,
+                }));
+            }
+            cells.push(CellInput {
+                angle_deg: angle,
+                shape: shape.name().to_string(),
+                swept: Default::default(),
+                planned_samples: 3,
+                planned_impacts: 30,
+                samples,
+            });
+        }
+    }
+    let results = aggregate_campaign(&cells, SLOPE_WINDOW).unwrap();
+    let mut v = serde_json::to_value(results).unwrap();
+    v["raw"] = serde_json::Value::Array(raw);
+    v
+}
+
+#[test]
+fn plot_draws_raw_series_oka_fits_and_the_modified_model() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("results.json");
+    std::fs::write(&path, synthetic_results().to_string()).unwrap();
+    let (dir, stdout) = plot(&path);
+    let files = stems(dir.path());
+    for stem in [
+        "mass_loss_c00_15deg_octagon",
+        "mass_loss_c17_90deg_square",
+        "erosion_vs_angle",
+        "erosion_normalised_45deg",
+        "modified_oka",
+        "convergence",
+    ] {
+        assert_has(&files, stem);
+    }
+    assert_eq!(check_images(dir.path()), 18 + 4);
+    for shape in ["octagon", "hexagon", "square"] {
+        assert!(
+            stdout.contains(&format!("{shape}: Oka fit n1 = ")),
+            "{stdout}"
+        );
+    }
+    assert!(stdout.contains("modified Oka fit: n3"), "{stdout}");
+    // The raw series are drawn: the per-sample legend names their count.
+    let svg = std::fs::read_to_string(dir.path().join("mass_loss_c07_30deg_hexagon.svg")).unwrap();
+    assert!(svg.contains("each sample (3)"), "raw series not drawn");
+}
+
+#[test]
+fn plot_rejects_bad_input_with_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = tmp.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let cases = [
+        (tmp.path().join("absent.json"), "absent.json"),
+        (write("broken.json", "{\"cells\": [ {"), "not valid JSON"),
+        (
+            write("other.json", "{\"name\": \"quick\"}"),
+            "no `cells` array",
+        ),
+        (write("empty.json", "{\"cells\": []}"), "`cells` is empty"),
+        (
+            write("cell.json", "{\"cells\": [{\"shape\": 3}]}"),
+            "not a results file",
+        ),
+    ];
+    for (path, expected) in cases {
+        let out = grit(&[
+            "plot",
+            path.to_str().unwrap(),
+            "--out",
+            tmp.path().to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{} succeeded", path.display());
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(expected),
+            "{}: {stderr}",
+            path.display()
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
