@@ -221,6 +221,17 @@ fn plot_draws_raw_series_oka_fits_and_the_modified_model() {
 }
 
 #[test]
+fn plot_draws_the_committed_raw_results() {
+    let (dir, stdout) = plot(&data("quick-raw-results.json"));
+    let files = stems(dir.path());
+    assert_has(&files, "mass_loss_c00_45deg_hexagon");
+    assert_has(&files, "erosion_vs_angle");
+    assert!(check_images(dir.path()) >= 4, "{stdout}");
+    let svg = std::fs::read_to_string(dir.path().join("mass_loss_c00_45deg_hexagon.svg")).unwrap();
+    assert!(svg.contains("each sample (2)"), "raw series not drawn");
+}
+
+#[test]
 fn plot_rejects_bad_input_with_a_clear_error() {
     let tmp = tempfile::tempdir().unwrap();
     let write = |name: &str, text: &str| {
