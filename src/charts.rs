@@ -6,17 +6,6 @@ use anyhow::anyhow;
 use grit_sph::verification::Chart;
 use plotters::prelude::*;
 
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-];
-
 /// Writes `chart` as an SVG line chart with labelled axes and a legend.
 pub fn line_chart(chart: &Chart, path: &Path) -> anyhow::Result<()> {
     let pts = chart
@@ -60,9 +49,9 @@ pub fn line_chart(chart: &Chart, path: &Path) -> anyhow::Result<()> {
     for s in &chart.series {
         // A reference takes the colour of the simulation drawn just before it.
         let c = if s.reference && colour > 0 {
-            PALETTE[(colour - 1) % PALETTE.len()]
+            grit_plot::colour(colour - 1)
         } else {
-            PALETTE[colour % PALETTE.len()]
+            grit_plot::colour(colour)
         };
         let data: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
         if s.reference {

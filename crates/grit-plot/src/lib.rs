@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 
 use grit_erosion::CampaignResults;
 
+pub use draw::colour;
 pub use fonts::register_fonts;
 pub use input::{load, parse, PlotInput, RawImpact, RawSeries};
 
