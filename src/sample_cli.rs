@@ -48,12 +48,13 @@ pub fn shapes(a: ShapesArgs) -> anyhow::Result<ExitCode> {
 /// The impact scene as command-line flags (seed section 4 defaults).
 #[derive(clap::Args)]
 pub struct SceneArgs {
-    /// Impact angle, degrees from the surface, in (0, 90].
+    /// Impact angle, degrees from the surface, in (0, 90] (required unless a scene file or
+    /// checkpoint gives it).
     #[arg(long)]
-    angle: f64,
-    /// Grain shape: octagon, hexagon, square, rectangle or circle.
-    #[arg(long, default_value = "hexagon")]
-    shape: String,
+    angle: Option<f64>,
+    /// Grain shape: octagon, hexagon, square, rectangle or circle [default: hexagon].
+    #[arg(long)]
+    shape: Option<String>,
     /// Particle spacing Δx (m); the seed's is 8e-6.
     #[arg(long)]
     spacing_m: Option<f64>,
@@ -88,14 +89,19 @@ impl SceneArgs {
             }
             None => ImpactParams::default(),
         };
-        p.angle_deg = self.angle;
-        p.shape = Shape::from_name(&self.shape).with_context(|| {
-            format!(
-                "shape: unknown `{}`; expected one of {}",
-                self.shape,
-                grit_erosion::shapes::BUILTIN_NAMES.join(", ")
-            )
-        })?;
+        match (self.angle, &self.scene) {
+            (Some(a), _) => p.angle_deg = a,
+            (None, Some(_)) => {}
+            (None, None) => bail!("angle: required (--angle DEG, in (0, 90])"),
+        }
+        if let Some(name) = &self.shape {
+            p.shape = Shape::from_name(name).with_context(|| {
+                format!(
+                    "shape: unknown `{name}`; expected one of {}",
+                    grit_erosion::shapes::BUILTIN_NAMES.join(", ")
+                )
+            })?;
+        }
         let set = |dst: &mut f64, v: Option<f64>| {
             if let Some(v) = v {
                 *dst = v;
@@ -134,6 +140,10 @@ pub struct SampleArgs {
     /// Also write the JSON result (with every impact's details) to this file.
     #[arg(long, short)]
     out: Option<PathBuf>,
+    /// Go on from a checkpoint file (a job's saved surface, e.g. taken from the farm's
+    /// database) with the parameters and seed stored in it; `--impacts` is then the total.
+    #[arg(long)]
+    resume: Option<PathBuf>,
 }
 
 fn pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
@@ -178,13 +188,28 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
     if a.impacts == 0 {
         bail!("impacts: must be at least 1");
     }
-    let p = a.scene.params()?;
+    let mut s = match &a.resume {
+        Some(path) => {
+            let bytes =
+                std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+            Sample::from_checkpoint(&bytes).with_context(|| format!("resume {}", path.display()))?
+        }
+        None => Sample::new(a.scene.params()?, a.seed)?,
+    };
+    let p = s.params().clone();
+    let seed = s.seed();
+    if s.impacts_done() >= a.impacts {
+        bail!(
+            "impacts: the checkpoint already holds {} impacts; ask for more than that",
+            s.impacts_done()
+        );
+    }
     let pool = pool(a.threads)?;
-    let mut s = Sample::new(p.clone(), a.seed)?;
     let bar = impact_bar(a.impacts)?;
+    bar.set_position(s.impacts_done() as u64);
     let t0 = Instant::now();
     let mut failure = None;
-    for _ in 0..a.impacts {
+    for _ in s.impacts_done()..a.impacts {
         if let Err(e) = pool.install(|| s.run_next().map(|_| ())) {
             // Keep what the finished impacts found: they are written below, then the error.
             failure = Some(e);
@@ -202,7 +227,7 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
     let cum = cumulative_series(&impacts);
     let out = SampleOutput {
         params: &p,
-        seed: a.seed,
+        seed,
         series: cum
             .iter()
             .zip(s.records())

@@ -194,6 +194,18 @@ impl Sample {
     /// Goes on from `checkpoint()` bytes. The parameters and seed must be the job's own:
     /// resuming a different job's surface would give silently wrong numbers.
     pub fn resume(params: &ImpactParams, seed: u64, bytes: &[u8]) -> Result<Sample, SampleError> {
+        let s = Sample::from_checkpoint(bytes)?;
+        if s.params != *params || s.seed != seed {
+            return Err(SampleError::Checkpoint(
+                "belongs to another job (parameters or seed differ)".into(),
+            ));
+        }
+        Ok(s)
+    }
+
+    /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them (for
+    /// replaying a job's checkpoint by hand; the farm uses `resume`).
+    pub fn from_checkpoint(bytes: &[u8]) -> Result<Sample, SampleError> {
         let c: Checkpoint = postcard::from_bytes(bytes)
             .map_err(|e| SampleError::Checkpoint(format!("cannot decode: {e}")))?;
         if c.version != CHECKPOINT_VERSION {
@@ -204,11 +216,7 @@ impl Sample {
         }
         let saved: ImpactParams = serde_json::from_str(&c.params_json)
             .map_err(|e| SampleError::Checkpoint(format!("cannot decode parameters: {e}")))?;
-        if saved != *params || c.seed != seed {
-            return Err(SampleError::Checkpoint(
-                "belongs to another job (parameters or seed differ)".into(),
-            ));
-        }
+        saved.validate()?;
         if !c.surface.is_consistent() {
             return Err(SampleError::Checkpoint(
                 "surface arrays have different lengths".into(),
