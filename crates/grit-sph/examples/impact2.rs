@@ -1,28 +1,39 @@
-//! Elastic impact energy with filter/hourglass switched: `cargo run --release --example impact2 -- 30 40 0.1`.
+//! Elastic impact energy with filter/hourglass and the disc switched:
+//! `cargo run --release --example impact2 -- N FILTER_EVERY HOURGLASS [RADIUS_M SPEED_M_S DENSITY]`.
+use grit_sph::verification::elastic_impact::{simulate_with, Disc};
+
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let n: usize = a[1].parse().unwrap();
+    let arg = |k: usize| a.get(k).map(|x| x.parse::<f64>().expect("a number"));
+    let n = arg(1).expect("N") as usize;
     let s = grit_sph::Settings {
-        shepard_interval: a[2].parse().unwrap(),
-        hourglass: a[3].parse().unwrap(),
+        shepard_interval: arg(2).expect("FILTER_EVERY") as u32,
+        hourglass: arg(3).expect("HOURGLASS"),
         ..Default::default()
     };
-    let t_end: Option<f64> = a.get(4).map(|x| x.parse().unwrap());
-    let h = match grit_sph::verification::elastic_impact::simulate_until(n, s, t_end) {
+    let d = Disc::default();
+    let disc = Disc {
+        radius_m: arg(4).unwrap_or(d.radius_m),
+        speed_m_s: arg(5).unwrap_or(d.speed_m_s),
+        density_kg_m3: arg(6).unwrap_or(d.density_kg_m3),
+    };
+    let t0 = std::time::Instant::now();
+    let h = match simulate_with(n, s, disc, None) {
         Ok(h) => h,
         Err(e) => {
             println!("{e}");
             return;
         }
     };
-    let lc = h.in_contact.iter().rposition(|&c| c).unwrap_or(0);
     println!(
-        "peak {:.4} after {:.4} at contact end {:.4} hg {:.3e} filt {:.3e} steps {}",
-        h.energy.iter().cloned().fold(0.0, f64::max),
+        "peak {:.4} at release {:.4} end {:.4} filter {:.4} hourglass {:.4} damping {:.4} steps {} wall {:.1} s",
+        h.peak,
+        h.at_release,
         h.energy.last().unwrap(),
-        h.energy[lc],
-        h.work.hourglass,
         h.work.density_filter,
-        h.t.len() * 10
+        h.work.hourglass,
+        h.work.contact_damping,
+        h.t.len() * 10,
+        t0.elapsed().as_secs_f64()
     );
 }

@@ -42,8 +42,34 @@ pub struct History {
     pub work: NumericalWork,
 }
 
+/// The disc of the scene: size, speed and density.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Disc {
+    /// Radius (m).
+    pub radius_m: f64,
+    /// Impact speed (m/s).
+    pub speed_m_s: f64,
+    /// Density (kg/m³).
+    pub density_kg_m3: f64,
+}
+
+impl Default for Disc {
+    fn default() -> Self {
+        Disc {
+            radius_m: RADIUS,
+            speed_m_s: SPEED,
+            density_kg_m3: 7800.0,
+        }
+    }
+}
+
 /// Builds the scene with `n` particles along the block side.
 pub fn scene(n: usize, settings: Settings) -> World {
+    scene_with(n, settings, Disc::default())
+}
+
+/// Builds the scene with `n` particles along the block side and the given disc.
+pub fn scene_with(n: usize, settings: Settings, disc: Disc) -> World {
     let dx = BLOCK / n as f64;
     let mut w = World::new(Settings {
         spacing_m: dx,
@@ -60,14 +86,14 @@ pub fn scene(n: usize, settings: Settings) -> World {
             Vector::zeros(),
         )
         .expect("block");
-    let disc =
-        Polygon::regular(64, RADIUS, 0.0).translated(Vector::new(0.5 * BLOCK, BLOCK + RADIUS + dx));
+    let polygon = Polygon::regular(64, disc.radius_m, 0.0)
+        .translated(Vector::new(0.5 * BLOCK, BLOCK + disc.radius_m + dx));
     let d = w
         .add_rigid(
             "disc",
-            &disc,
-            7800.0,
-            Vector::new(0.0, -SPEED),
+            &polygon,
+            disc.density_kg_m3,
+            Vector::new(0.0, -disc.speed_m_s),
             0.0,
             Motion::Free,
         )
@@ -88,7 +114,17 @@ pub fn simulate_until(
     settings: Settings,
     t_end: Option<f64>,
 ) -> Result<History, SimError> {
-    let mut w = scene(n, settings);
+    simulate_with(n, settings, Disc::default(), t_end)
+}
+
+/// As `simulate_until`, with the given disc.
+pub fn simulate_with(
+    n: usize,
+    settings: Settings,
+    disc: Disc,
+    t_end: Option<f64>,
+) -> Result<History, SimError> {
+    let mut w = scene_with(n, settings, disc);
     let e0 = w.energy().total();
     let p0 = w.momentum();
     let mut h = History {
@@ -98,7 +134,9 @@ pub fn simulate_until(
     };
     let mut touched = false;
     let mut left_at = None;
-    let t_max = t_end.unwrap_or(40.0 * RADIUS / SPEED);
+    // Flight distances, not disc radii: a larger disc should not mean a longer wait.
+    let speed = disc.speed_m_s;
+    let t_max = t_end.unwrap_or(40.0 * RADIUS / speed);
     while w.time() < t_max {
         w.step()?;
         let touching = w.contact_forces().iter().any(|f| f.norm() > 0.0);
@@ -122,7 +160,7 @@ pub fn simulate_until(
             h.in_contact.push(touching);
         }
         if let (Some(t), None) = (left_at, t_end) {
-            if w.time() > t + 2.0 * RADIUS / SPEED {
+            if w.time() > t + 2.0 * RADIUS / speed {
                 break;
             }
         }
