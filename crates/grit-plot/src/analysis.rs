@@ -132,18 +132,40 @@ impl Analysis {
         for s in &mut series {
             s.points.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
             s.oka = oka_curves(&s.points);
+            let rms = |model: &OkaModel| {
+                let ss: f64 = s
+                    .points
+                    .iter()
+                    .map(|p| (p.mean - model.erosion(p.angle_deg)).powi(2))
+                    .sum();
+                (ss / s.points.len() as f64).sqrt()
+            };
             match &s.oka.fit {
                 Ok(f) => notes.push(format!(
-                    "{}: Oka fit n1 = {:.3}, n2 = {:.3}, E90 = {:.3e}, maximum erosion at {:.1}°",
-                    s.label, f.model.n1, f.model.n2, f.model.e90, f.angle_max_deg
+                    "{}: Oka fit n1 = {:.3}, n2 = {:.3}, E90 = {:.3e}, maximum erosion at {:.1}°, \
+                     RMS residual {:.2e}",
+                    s.label,
+                    f.model.n1,
+                    f.model.n2,
+                    f.model.e90,
+                    f.angle_max_deg,
+                    rms(&f.model)
                 )),
                 Err(e) => notes.push(format!("{}: no Oka fit ({e})", s.label)),
             }
-            if let Err(e) = &s.oka.published {
-                notes.push(format!(
+            match &s.oka.published {
+                Ok(m) => notes.push(format!(
+                    "{}: Oka's silica exponents with the simulated E90 = {:.3e}: maximum erosion \
+                     at {:.1}°, RMS residual {:.2e}",
+                    s.label,
+                    m.e90,
+                    m.max_angle_deg(),
+                    rms(m)
+                )),
+                Err(e) => notes.push(format!(
                     "{}: no published-exponent Oka curve ({e})",
                     s.label
-                ));
+                )),
             }
         }
         let modified = modified(&series);

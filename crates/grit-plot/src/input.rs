@@ -96,6 +96,62 @@ pub fn parse(text: &str) -> Result<PlotInput, PlotError> {
     Ok(PlotInput { results, raw })
 }
 
+/// Several results files as one: cells in file order, a cell whose angle, shape and swept
+/// values an earlier file already has is left out (so a full campaign can be drawn with the
+/// shapes of a smaller one beside it); `raw` is kept only when every file has it. Returns the
+/// merged input and a note per cell left out.
+pub fn merge(inputs: Vec<(String, PlotInput)>) -> Result<(PlotInput, Vec<String>), PlotError> {
+    let mut iter = inputs.into_iter();
+    let Some((first_name, first)) = iter.next() else {
+        return Err(PlotError::Input("no results file given".into()));
+    };
+    let window = first.results.slope_window;
+    let mut names = vec![first_name; first.results.cells.len()];
+    let mut merged = first;
+    let mut notes = Vec::new();
+    for (name, input) in iter {
+        if input.results.slope_window != window {
+            return Err(PlotError::Input(format!(
+                "{name}: slope_window {} but the first file has {window}; erosions over \
+                 different windows cannot be drawn together",
+                input.results.slope_window
+            )));
+        }
+        let mut new_index = Vec::with_capacity(input.results.cells.len());
+        for c in input.results.cells {
+            let same = merged.results.cells.iter().position(|m| {
+                m.angle_deg == c.angle_deg && m.shape == c.shape && m.swept == c.swept
+            });
+            match same {
+                Some(k) => {
+                    notes.push(format!(
+                        "{name}: cell {}° {} left out; {} has it",
+                        c.angle_deg, c.shape, names[k]
+                    ));
+                    new_index.push(None);
+                }
+                None => {
+                    new_index.push(Some(merged.results.cells.len() as u32));
+                    names.push(name.clone());
+                    merged.results.partial |= c.partial;
+                    merged.results.cells.push(c);
+                }
+            }
+        }
+        merged.raw = match (merged.raw.take(), input.raw) {
+            (Some(mut all), Some(more)) => {
+                all.extend(more.into_iter().filter_map(|mut r| {
+                    r.cell = new_index[r.cell as usize]?;
+                    Some(r)
+                }));
+                Some(all)
+            }
+            _ => None,
+        };
+    }
+    Ok((merged, notes))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,5 +189,39 @@ mod tests {
         assert_eq!(p.raw.unwrap()[0].impacts[0].grain_mass_kg, 1e-4);
         let stray = with.replace(r#""cell": 0"#, r#""cell": 4"#);
         assert!(err(&stray).starts_with("raw[0].cell"));
+    }
+
+    #[test]
+    fn merge_keeps_the_first_files_cells_and_reindexes_raw() {
+        let cell90 = CELL.replace("45.0", "90.0");
+        let raw = |cell: u32| {
+            format!(
+                r#"{{"cell": {cell}, "sample": 0, "impacts": [{{"grain_mass_kg": 1e-4,
+                "mass_loss_kg": 0.0}}]}}"#
+            )
+        };
+        let a = parse(&format!(
+            r#"{{"partial": false, "slope_window": 20, "cells": [{CELL}], "raw": [{}]}}"#,
+            raw(0)
+        ))
+        .unwrap();
+        let b = parse(&format!(
+            r#"{{"partial": false, "slope_window": 20, "cells": [{CELL}, {cell90}],
+            "raw": [{}, {}]}}"#,
+            raw(0),
+            raw(1)
+        ))
+        .unwrap();
+        let (m, notes) = merge(vec![("a".into(), a.clone()), ("b".into(), b)]).unwrap();
+        assert_eq!(m.results.cells.len(), 2);
+        assert_eq!(m.results.cells[1].angle_deg, 90.0);
+        assert_eq!(notes.len(), 1);
+        assert!(notes[0].contains("b: cell 45° hexagon left out; a has it"));
+        let raw = m.raw.unwrap();
+        assert_eq!(raw.iter().map(|r| r.cell).collect::<Vec<_>>(), vec![0, 1]);
+        let other = a.clone();
+        let mut c = other.clone();
+        c.results.slope_window = 10;
+        assert!(merge(vec![("a".into(), other), ("c".into(), c)]).is_err());
     }
 }

@@ -21,7 +21,7 @@ use grit_erosion::CampaignResults;
 
 pub use draw::colour;
 pub use fonts::register_fonts;
-pub use input::{load, parse, PlotInput, RawImpact, RawSeries};
+pub use input::{load, merge, parse, PlotInput, RawImpact, RawSeries};
 
 /// Why charts could not be made: unreadable or invalid input, or an unwritable output.
 #[derive(Debug, thiserror::Error)]
