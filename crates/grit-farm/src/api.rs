@@ -141,6 +141,127 @@ pub struct CampaignStatus {
     pub created_ms: i64,
 }
 
+/// Job state (the `state` column of the jobs table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum JobState {
+    /// Waiting for a worker.
+    Queued,
+    /// Held by a worker.
+    Leased,
+    /// Finished.
+    Done,
+    /// Failed after the maximum number of attempts.
+    Failed,
+    /// Cancelled with its campaign.
+    Cancelled,
+}
+
+impl JobState {
+    /// Every state, in the order a job passes through them.
+    pub const ALL: [JobState; 5] = [
+        JobState::Queued,
+        JobState::Leased,
+        JobState::Done,
+        JobState::Failed,
+        JobState::Cancelled,
+    ];
+
+    /// The name used in JSON, SQL and query strings.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobState::Queued => "queued",
+            JobState::Leased => "leased",
+            JobState::Done => "done",
+            JobState::Failed => "failed",
+            JobState::Cancelled => "cancelled",
+        }
+    }
+
+    /// The state named `s`, if any.
+    pub fn parse(s: &str) -> Option<JobState> {
+        JobState::ALL.into_iter().find(|j| j.as_str() == s)
+    }
+}
+
+/// One row of `GET /campaigns/{id}/jobs`.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct JobInfo {
+    /// Job id.
+    pub job_id: i64,
+    /// Cell index.
+    pub cell: u32,
+    /// Sample index within the cell.
+    pub sample: u32,
+    /// Job state.
+    pub state: JobState,
+    /// Attempts lost (expired or failed leases).
+    pub attempts: u32,
+    /// Impacts stored.
+    pub impacts_done: u32,
+    /// Impacts planned.
+    pub impacts_planned: u32,
+    /// The worker holding it (leased), or the one that finished it (done).
+    pub worker: Option<String>,
+    /// Lease expiry while leased, Unix milliseconds.
+    pub lease_expires_ms: Option<i64>,
+    /// Last change of state, claim or heartbeat, Unix milliseconds.
+    pub updated_ms: i64,
+    /// The last error a worker reported for it, or why its lease was lost.
+    pub last_error: Option<String>,
+}
+
+/// A job a worker holds, as `GET /workers` shows it.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct HeldJob {
+    /// Job id.
+    pub job_id: i64,
+    /// Campaign id.
+    pub campaign_id: Uuid,
+    /// The campaign's name, if given.
+    pub campaign_name: Option<String>,
+    /// Cell index.
+    pub cell: u32,
+    /// Impact angle of the cell, degrees.
+    pub angle_deg: f64,
+    /// Grain shape of the cell.
+    pub shape: String,
+    /// Sample index within the cell.
+    pub sample: u32,
+    /// Impacts stored.
+    pub impacts_done: u32,
+    /// Impacts planned.
+    pub impacts_planned: u32,
+    /// The lease's last claim or heartbeat, Unix milliseconds.
+    pub last_heartbeat_ms: i64,
+    /// Lease expiry, Unix milliseconds.
+    pub lease_expires_ms: i64,
+}
+
+/// A worker seen recently.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct WorkerInfo {
+    /// The name it claims with (`grit work --name`, by default `host:pid`).
+    pub name: String,
+    /// First claim, Unix milliseconds.
+    pub first_seen_ms: i64,
+    /// Last claim or heartbeat, Unix milliseconds.
+    pub last_seen_ms: i64,
+    /// Jobs it holds now (one for `grit work`; more only if two workers share a name).
+    pub jobs: Vec<HeldJob>,
+}
+
+/// `GET /workers`: workers heard from within the window, most recently seen first.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct WorkersResponse {
+    /// The coordinator's lease length, seconds: a worker silent for longer has lost its job.
+    pub lease_ttl_s: f64,
+    /// The window asked for, seconds.
+    pub seen_within_s: f64,
+    /// The workers, most recently seen first.
+    pub workers: Vec<WorkerInfo>,
+}
+
 /// The per-impact series of one sample (`?raw=true`).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 pub struct RawSample {

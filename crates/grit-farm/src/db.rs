@@ -18,7 +18,8 @@ use uuid::Uuid;
 
 use crate::api::{
     CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress, Checkpoint,
-    ClaimedJob, HeartbeatResponse, JobCounts, JobError, RawSample, ResultsResponse,
+    ClaimedJob, HeartbeatResponse, HeldJob, JobCounts, JobError, JobInfo, JobState, RawSample,
+    ResultsResponse, WorkerInfo, WorkersResponse,
 };
 use crate::error::{Error, Result};
 
@@ -26,6 +27,8 @@ use crate::error::{Error, Result};
 const MAX_ERROR_CHARS: usize = 4000;
 /// Window over which the impact rate (and so the ETA) is measured.
 const RATE_WINDOW_MS: i64 = 120_000;
+/// Workers silent for longer are forgotten, so the table of names cannot grow without end.
+const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 
 /// Current time in Unix milliseconds.
 pub fn now_ms() -> i64 {
@@ -438,6 +441,101 @@ impl Store {
             .collect())
     }
 
+    /// A campaign's jobs in cell and sample order, only those in `state` if given, at most
+    /// `limit` of them.
+    pub async fn jobs(
+        &self,
+        id: Uuid,
+        state: Option<JobState>,
+        limit: u32,
+    ) -> Result<Vec<JobInfo>> {
+        self.campaign_row(id).await?;
+        let rows = sqlx::query(
+            "SELECT id, cell_index, sample_index, state, attempts, impacts_done, impacts_planned,
+                    worker, lease_expires_ms, updated_ms, last_error
+             FROM jobs WHERE campaign_id = ?1 AND (?2 IS NULL OR state = ?2)
+             ORDER BY cell_index, sample_index LIMIT ?3",
+        )
+        .bind(id.to_string())
+        .bind(state.map(JobState::as_str))
+        .bind(limit as i64)
+        .fetch_all(&self.read)
+        .await?;
+        rows.iter()
+            .map(|r| {
+                Ok(JobInfo {
+                    job_id: r.get("id"),
+                    cell: r.get::<i64, _>("cell_index") as u32,
+                    sample: r.get::<i64, _>("sample_index") as u32,
+                    state: job_state(&r.get::<String, _>("state"))?,
+                    attempts: r.get::<i64, _>("attempts") as u32,
+                    impacts_done: r.get::<i64, _>("impacts_done") as u32,
+                    impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
+                    worker: r.get("worker"),
+                    lease_expires_ms: r.get("lease_expires_ms"),
+                    updated_ms: r.get("updated_ms"),
+                    last_error: r.get("last_error"),
+                })
+            })
+            .collect()
+    }
+
+    /// Workers heard from within `within`, most recently seen first, with the jobs they hold.
+    pub async fn workers(&self, within: Duration) -> Result<WorkersResponse> {
+        let since = now_ms() - within.as_millis().min(i64::MAX as u128) as i64;
+        let rows = sqlx::query(
+            "SELECT name, first_seen_ms, last_seen_ms FROM workers WHERE last_seen_ms >= ?
+             ORDER BY last_seen_ms DESC, name",
+        )
+        .bind(since)
+        .fetch_all(&self.read)
+        .await?;
+        let mut held: BTreeMap<String, Vec<HeldJob>> = BTreeMap::new();
+        for r in sqlx::query(
+            "SELECT j.id, j.campaign_id, c.name AS campaign_name, j.cell_index, k.angle_deg,
+                    k.shape, j.sample_index, j.impacts_done, j.impacts_planned, j.updated_ms,
+                    j.lease_expires_ms, j.worker
+             FROM jobs j
+             JOIN campaigns c ON c.id = j.campaign_id
+             JOIN cells k ON k.campaign_id = j.campaign_id AND k.cell_index = j.cell_index
+             WHERE j.state = 'leased' AND j.worker IS NOT NULL ORDER BY j.id",
+        )
+        .fetch_all(&self.read)
+        .await?
+        {
+            held.entry(r.get("worker")).or_default().push(HeldJob {
+                job_id: r.get("id"),
+                campaign_id: parse_uuid(&r.get::<String, _>("campaign_id"))?,
+                campaign_name: r.get("campaign_name"),
+                cell: r.get::<i64, _>("cell_index") as u32,
+                angle_deg: r.get("angle_deg"),
+                shape: r.get("shape"),
+                sample: r.get::<i64, _>("sample_index") as u32,
+                impacts_done: r.get::<i64, _>("impacts_done") as u32,
+                impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
+                // Claims and heartbeats are the only writes to a leased job's updated_ms.
+                last_heartbeat_ms: r.get("updated_ms"),
+                lease_expires_ms: r.get::<Option<i64>, _>("lease_expires_ms").unwrap_or(0),
+            });
+        }
+        Ok(WorkersResponse {
+            lease_ttl_s: self.lease_ttl.as_secs_f64(),
+            seen_within_s: within.as_secs_f64(),
+            workers: rows
+                .iter()
+                .map(|r| {
+                    let name: String = r.get("name");
+                    WorkerInfo {
+                        jobs: held.remove(&name).unwrap_or_default(),
+                        name,
+                        first_seen_ms: r.get("first_seen_ms"),
+                        last_seen_ms: r.get("last_seen_ms"),
+                    }
+                })
+                .collect(),
+        })
+    }
+
     /// Cancels a campaign: unfinished jobs become `cancelled` (their holders learn it at the
     /// next heartbeat). Returns how many jobs changed.
     pub async fn cancel(&self, id: Uuid) -> Result<u64> {
@@ -505,7 +603,12 @@ impl Store {
     /// marks them failed when they reach the maximum. Returns how many.
     pub async fn reap_expired(&self) -> Result<u64> {
         let mut tx = self.begin().await?;
-        let n = reap(&mut tx, now_ms()).await?;
+        let now = now_ms();
+        let n = reap(&mut tx, now).await?;
+        sqlx::query("DELETE FROM workers WHERE last_seen_ms < ?")
+            .bind(now - WORKER_FORGET_MS)
+            .execute(&mut *tx)
+            .await?;
         tx.commit().await?;
         Ok(n)
     }
@@ -532,6 +635,15 @@ impl Store {
         let mut tx = self.begin().await?;
         let now = now_ms();
         reap(&mut tx, now).await?;
+        // Every claim counts as a sign of life, an empty queue's too: idle workers are listed.
+        sqlx::query(
+            "INSERT INTO workers (name, first_seen_ms, last_seen_ms) VALUES (?1, ?2, ?2)
+             ON CONFLICT (name) DO UPDATE SET last_seen_ms = excluded.last_seen_ms",
+        )
+        .bind(worker)
+        .bind(now)
+        .execute(&mut *tx)
+        .await?;
         let lease = Uuid::new_v4();
         let expires = now + self.lease_ttl.as_millis() as i64;
         let Some(r) = sqlx::query(
@@ -596,6 +708,7 @@ impl Store {
         let mut tx = self.begin().await?;
         let now = now_ms();
         let held = check_lease(&mut tx, job_id, lease, now).await?;
+        touch_worker(&mut tx, job_id, now).await?;
         let done = store_impacts(&mut tx, job_id, &held, impacts, now).await?;
         if let Some(c) = checkpoint {
             store_checkpoint(&mut tx, job_id, done, c, now).await?;
@@ -622,6 +735,7 @@ impl Store {
         let mut tx = self.begin().await?;
         let now = now_ms();
         let held = check_lease(&mut tx, job_id, lease, now).await?;
+        touch_worker(&mut tx, job_id, now).await?;
         let done = store_impacts(&mut tx, job_id, &held, impacts, now).await?;
         if done < held.planned {
             return Err(Error::invalid(
@@ -662,6 +776,7 @@ impl Store {
         let mut tx = self.begin().await?;
         let now = now_ms();
         let held = check_lease(&mut tx, job_id, lease, now).await?;
+        touch_worker(&mut tx, job_id, now).await?;
         let done = store_impacts(&mut tx, job_id, &held, impacts, now).await?;
         let error: String = error.chars().take(MAX_ERROR_CHARS).collect();
         sqlx::query(
@@ -694,6 +809,7 @@ impl Store {
         let mut tx = self.begin().await?;
         let now = now_ms();
         let held = check_lease(&mut tx, job_id, lease, now).await?;
+        touch_worker(&mut tx, job_id, now).await?;
         let done = store_impacts(&mut tx, job_id, &held, impacts, now).await?;
         if let Some(c) = checkpoint {
             store_checkpoint(&mut tx, job_id, done, c, now).await?;
@@ -754,6 +870,24 @@ async fn check_lease(
         planned: r.get::<i64, _>("impacts_planned") as u32,
         done: r.get::<i64, _>("impacts_done") as u32,
     })
+}
+
+/// Marks the worker holding `job_id` as seen at `now`; called by every write of a lease
+/// holder before anything clears `jobs.worker`.
+async fn touch_worker(tx: &mut Transaction<'static, Sqlite>, job_id: i64, now: i64) -> Result<()> {
+    sqlx::query(
+        "UPDATE workers SET last_seen_ms = ?
+         WHERE name = (SELECT worker FROM jobs WHERE id = ?)",
+    )
+    .bind(now)
+    .bind(job_id)
+    .execute(&mut **tx)
+    .await?;
+    Ok(())
+}
+
+fn job_state(s: &str) -> Result<JobState> {
+    JobState::parse(s).ok_or_else(|| Error::Internal(format!("stored job state {s:?}")))
 }
 
 /// Appends impacts after those stored; ones already stored are skipped (a resumed job
@@ -942,6 +1076,36 @@ mod tests {
         assert!(e.error.contains("lease expired"), "{}", e.error);
         assert_eq!(s.retry_failed(id).await.unwrap(), 1);
         assert_eq!(s.status(id).await.unwrap().jobs.queued, 2);
+    }
+
+    #[tokio::test]
+    async fn workers_are_listed_idle_or_with_the_job_they_hold() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = store(dir.path(), 60_000).await;
+        assert!(s.claim("idle").await.unwrap().is_none());
+        let spec = CampaignSpec::from_json(TINY).unwrap();
+        let id = s.create_campaign(&spec, None).await.unwrap().id;
+        let j = s.claim("busy").await.unwrap().unwrap();
+        tokio::time::sleep(Duration::from_millis(5)).await;
+        s.heartbeat(j.job_id, j.lease_id, &[], None).await.unwrap();
+        let w = s.workers(Duration::from_secs(60)).await.unwrap();
+        let names: Vec<&str> = w.workers.iter().map(|w| w.name.as_str()).collect();
+        assert_eq!(names, ["busy", "idle"], "most recently seen first");
+        let held = &w.workers[0].jobs;
+        assert_eq!(held.len(), 1);
+        assert_eq!((held[0].job_id, held[0].campaign_id), (j.job_id, id));
+        assert_eq!(held[0].last_heartbeat_ms, w.workers[0].last_seen_ms);
+        assert!(w.workers[1].jobs.is_empty());
+        // A failed attempt clears the job's worker, but the worker stays listed.
+        s.fail(j.job_id, j.lease_id, "boom", &[]).await.unwrap();
+        let w = s.workers(Duration::from_secs(60)).await.unwrap();
+        assert!(w.workers.iter().all(|w| w.jobs.is_empty()));
+        let queued = s.jobs(id, Some(JobState::Queued), 10).await.unwrap();
+        assert_eq!(queued.len(), 2);
+        assert_eq!(queued[0].last_error.as_deref(), Some("boom"));
+        assert_eq!(s.jobs(id, None, 1).await.unwrap().len(), 1);
+        let e = s.jobs(Uuid::new_v4(), None, 10).await.unwrap_err();
+        assert_eq!(e.status(), axum::http::StatusCode::NOT_FOUND);
     }
 
     #[tokio::test]

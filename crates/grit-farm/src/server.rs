@@ -2,6 +2,7 @@
 //! the OpenAPI document. `app` builds the router so tests and the embedded mode run the same
 //! service as `grit serve`.
 
+use std::collections::BTreeMap;
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::Duration;
@@ -243,6 +244,143 @@ async fn campaign_results(
     Ok(Json(s.store.results(campaign_id(&id)?, q.raw).await?))
 }
 
+/// Query of `GET /campaigns/{id}/jobs`.
+#[derive(utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+struct JobsQuery {
+    /// Only jobs in this state.
+    #[param(inline)]
+    state: Option<JobState>,
+    /// At most this many jobs, 1 to 10000 (default 1000).
+    limit: Option<u32>,
+}
+
+/// Most jobs one `GET /campaigns/{id}/jobs` answers with.
+const MAX_JOBS_LIMIT: u32 = 10_000;
+
+impl JobsQuery {
+    fn parse(q: &BTreeMap<String, String>) -> Result<JobsQuery> {
+        let mut out = JobsQuery {
+            state: None,
+            limit: None,
+        };
+        for (key, value) in q {
+            match key.as_str() {
+                "state" => {
+                    out.state = Some(JobState::parse(value).ok_or_else(|| {
+                        Error::invalid(
+                            "state",
+                            format!(
+                                "must be one of {}, got {value:?}",
+                                JobState::ALL.map(JobState::as_str).join(", ")
+                            ),
+                        )
+                    })?)
+                }
+                "limit" => {
+                    out.limit = Some(
+                        value
+                            .parse()
+                            .ok()
+                            .filter(|n| (1..=MAX_JOBS_LIMIT).contains(n))
+                            .ok_or_else(|| {
+                                Error::invalid(
+                                    "limit",
+                                    format!(
+                                    "must be an integer from 1 to {MAX_JOBS_LIMIT}, got {value:?}"
+                                ),
+                                )
+                            })?,
+                    )
+                }
+                other => return Err(unknown_param(other, "state, limit")),
+            }
+        }
+        Ok(out)
+    }
+}
+
+fn unknown_param(name: &str, expected: &str) -> Error {
+    Error::invalid(
+        name,
+        format!("unknown query parameter; this endpoint takes {expected}"),
+    )
+}
+
+/// A campaign's jobs, e.g. `?state=failed` for the failed ones with their errors.
+#[utoipa::path(get, path = "/api/v1/campaigns/{id}/jobs", params(("id" = Uuid, Path), JobsQuery),
+    responses((status = 200, body = Vec<JobInfo>, description = "in cell and sample order"), (status = 401),
+        (status = 404, body = ErrorBody), (status = 422, body = ErrorBody, description = "a bad `state` or `limit`, or an unknown parameter")),
+    security(("submit_token" = [])))]
+async fn campaign_jobs(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    Query(q): Query<BTreeMap<String, String>>,
+) -> Result<Json<Vec<JobInfo>>> {
+    let id = campaign_id(&id)?;
+    let q = JobsQuery::parse(&q)?;
+    Ok(Json(
+        s.store.jobs(id, q.state, q.limit.unwrap_or(1000)).await?,
+    ))
+}
+
+/// Query of `GET /workers`.
+#[derive(utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+struct WorkersQuery {
+    /// Only workers heard from (a claim or a heartbeat) within this many seconds, up to 30
+    /// days (default 900).
+    seen_within_s: Option<f64>,
+}
+
+/// Longest window of `GET /workers`: workers silent for a week are forgotten anyway.
+const MAX_SEEN_WITHIN_S: f64 = 30.0 * 24.0 * 3600.0;
+
+impl WorkersQuery {
+    fn parse(q: &BTreeMap<String, String>) -> Result<WorkersQuery> {
+        let mut out = WorkersQuery {
+            seen_within_s: None,
+        };
+        for (key, value) in q {
+            match key.as_str() {
+                "seen_within_s" => {
+                    out.seen_within_s = Some(
+                        value
+                            .parse::<f64>()
+                            .ok()
+                            .filter(|w| w.is_finite() && *w > 0.0 && *w <= MAX_SEEN_WITHIN_S)
+                            .ok_or_else(|| {
+                                Error::invalid(
+                                    "seen_within_s",
+                                    format!(
+                                        "must be a number of seconds above 0 and at most {MAX_SEEN_WITHIN_S}, got {value:?}"
+                                    ),
+                                )
+                            })?,
+                    )
+                }
+                other => return Err(unknown_param(other, "seen_within_s")),
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Workers seen recently, with the jobs they hold and their last heartbeats.
+#[utoipa::path(get, path = "/api/v1/workers", params(WorkersQuery),
+    responses((status = 200, body = WorkersResponse), (status = 401),
+        (status = 422, body = ErrorBody, description = "a bad `seen_within_s`, or an unknown parameter")),
+    security(("submit_token" = [])))]
+async fn list_workers(
+    State(s): State<AppState>,
+    Query(q): Query<BTreeMap<String, String>>,
+) -> Result<Json<WorkersResponse>> {
+    let within = WorkersQuery::parse(&q)?.seen_within_s.unwrap_or(900.0);
+    Ok(Json(
+        s.store.workers(Duration::from_secs_f64(within)).await?,
+    ))
+}
+
 #[utoipa::path(post, path = "/api/v1/campaigns/{id}/cancel", params(("id" = Uuid, Path)),
     responses((status = 200, body = JobsChanged), (status = 401), (status = 404, body = ErrorBody)),
     security(("submit_token" = [])))]
@@ -361,7 +499,8 @@ impl utoipa::Modify for Security {
 #[openapi(
     info(title = "grit coordinator", description = "Campaigns of SPH erosion impacts farmed out to workers (issue 4)."),
     paths(healthz, create_campaign, list_campaigns, campaign_status, campaign_results,
-          cancel_campaign, retry_failed, claim, heartbeat, complete, fail, release),
+          campaign_jobs, list_workers, cancel_campaign, retry_failed, claim, heartbeat, complete,
+          fail, release),
     modifiers(&Security)
 )]
 pub struct ApiDoc;
@@ -380,6 +519,8 @@ pub fn app(state: AppState) -> Router {
         .route("/campaigns", post(create_campaign).get(list_campaigns))
         .route("/campaigns/{id}", get(campaign_status))
         .route("/campaigns/{id}/results", get(campaign_results))
+        .route("/campaigns/{id}/jobs", get(campaign_jobs))
+        .route("/workers", get(list_workers))
         .route("/campaigns/{id}/cancel", post(cancel_campaign))
         .route("/campaigns/{id}/retry-failed", post(retry_failed))
         .route_layer(middleware::from_fn_with_state(
