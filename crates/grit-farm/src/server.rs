@@ -513,7 +513,7 @@ async fn not_found() -> Error {
     Error::NotFound("route".into())
 }
 
-/// The whole service.
+/// The whole service: the API under `/api/v1` and the dashboard page at `/`.
 pub fn app(state: AppState) -> Router {
     let campaigns = Router::new()
         .route("/campaigns", post(create_campaign).get(list_campaigns))
@@ -548,6 +548,7 @@ pub fn app(state: AppState) -> Router {
             Router::new().merge(campaigns).merge(worker).merge(open),
         )
         .route("/healthz", get(healthz))
+        .merge(crate::dashboard::router())
         .fallback(not_found)
         .layer(tower_http::trace::TraceLayer::new_for_http())
         .with_state(state)
