@@ -1,0 +1,524 @@
+//! The coordinator's dashboard (issue 6): `GET /` is a self-contained page served without a
+//! token and holding no data; `GET /api/v1/workers` and `GET /api/v1/campaigns/{id}/jobs`
+//! show the workers seen recently and the failed jobs with their errors; headless Chromium,
+//! given the submit token in the URL fragment, renders a campaign a real worker finished, its
+//! progress and its erosion chart from the live API. The real `grit` binary over loopback, a
+//! fresh SQLite file per test, real (coarse) SPH impacts. TEST_LOG=1 prints the processes'
+//! logs.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::{json, Value};
+
+const GRIT: &str = env!("CARGO_BIN_EXE_grit");
+const CHROMIUM: &str = "/usr/bin/chromium";
+const SUBMIT: &str = "dashboard-submit-token";
+const WORKER: &str = "dashboard-worker-token";
+
+/// The tests share two cores and time leases, so they run one at a time.
+static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
+
+/// The coarsest real scene of tests/farm.rs: 10 particles per grain diameter on a small
+/// surface, with `impacts` per sample.
+fn campaign(name: &str, angles: &str, samples: u32, impacts: u32) -> String {
+    format!(
+        r#"{{"name": "{name}", "seed": 11, "angles_deg": {angles}, "shapes": ["hexagon"],
+            "samples": {samples}, "impacts": {impacts}, "allow_short_samples": true,
+            "spacing_m": 25e-6, "surface_width_dg": 3.0, "surface_depth_dg": 1.3}}"#
+    )
+}
+
+/// A child process killed on drop, with its log in a file.
+struct Proc {
+    child: Child,
+    log: PathBuf,
+}
+
+impl Proc {
+    fn log_text(&self) -> String {
+        std::fs::read_to_string(&self.log).unwrap_or_default()
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        if std::env::var_os("TEST_LOG").is_some() {
+            eprintln!("--- {} ---\n{}", self.log.display(), self.log_text());
+        }
+    }
+}
+
+/// `grit serve` on a free loopback port; returns the process and its base URL.
+fn start_coordinator(dir: &Path, max_attempts: u32) -> (Proc, String) {
+    let log = dir.join("coordinator.log");
+    let mut child = Command::new(GRIT)
+        .args(["serve", "--db"])
+        .arg(dir.join("farm.db"))
+        .args(["--listen", "127.0.0.1:0", "--lease-ttl-s", "30"])
+        .args(["--max-attempts", &max_attempts.to_string()])
+        .env("GRIT_SUBMIT_TOKEN", SUBMIT)
+        .env("GRIT_WORKER_TOKEN", WORKER)
+        .env("RUST_LOG", "info")
+        .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .expect("grit serve starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = line
+        .trim()
+        .rsplit(' ')
+        .next()
+        .filter(|u| u.starts_with("http://"))
+        .unwrap_or_else(|| panic!("no address line from grit serve: {line:?}"))
+        .to_string();
+    (Proc { child, log }, url)
+}
+
+fn start_worker(dir: &Path, url: &str, name: &str) -> Proc {
+    let log = dir.join(format!("worker-{name}.log"));
+    let child = Command::new(GRIT)
+        .args(["work", "--coordinator", url, "--token", WORKER])
+        .args(["--threads", "1", "--poll-s", "0.2", "--name", name])
+        .env("RUST_LOG", "info")
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .expect("grit work starts");
+    Proc { child, log }
+}
+
+/// A small HTTP helper: JSON calls with a bearer token, answering (status, body).
+struct Api {
+    http: reqwest::Client,
+    base: String,
+}
+
+impl Api {
+    fn new(url: &str) -> Api {
+        Api {
+            http: reqwest::Client::new(),
+            base: format!("{url}/api/v1"),
+        }
+    }
+
+    async fn get(&self, path: &str, token: Option<&str>) -> (u16, Value) {
+        let mut rb = self.http.get(format!("{}{path}", self.base));
+        if let Some(t) = token {
+            rb = rb.bearer_auth(t);
+        }
+        let r = rb.send().await.unwrap();
+        let status = r.status().as_u16();
+        (status, r.json().await.unwrap_or(Value::Null))
+    }
+
+    async fn post(&self, path: &str, token: &str, body: &Value) -> (u16, Value) {
+        let r = self
+            .http
+            .post(format!("{}{path}", self.base))
+            .bearer_auth(token)
+            .json(body)
+            .send()
+            .await
+            .unwrap();
+        let status = r.status().as_u16();
+        (status, r.json().await.unwrap_or(Value::Null))
+    }
+
+    async fn submit(&self, spec: &str) -> String {
+        let r = self
+            .http
+            .post(format!("{}/campaigns", self.base))
+            .bearer_auth(SUBMIT)
+            .header("content-type", "application/json")
+            .body(spec.to_string())
+            .send()
+            .await
+            .unwrap();
+        assert_eq!(r.status().as_u16(), 201);
+        let body: Value = r.json().await.unwrap();
+        body["id"].as_str().unwrap().to_string()
+    }
+
+    async fn ok(&self, path: &str) -> Value {
+        let (status, body) = self.get(path, Some(SUBMIT)).await;
+        assert_eq!(status, 200, "GET {path}: {body}");
+        body
+    }
+}
+
+/// Claims the queued job as `worker` and reports a failure, as a worker whose engine stopped
+/// with an error does.
+async fn claim_and_fail(api: &Api, worker: &str, error: &str) -> i64 {
+    let (status, job) = api
+        .post("/worker/claim", WORKER, &json!({ "worker": worker }))
+        .await;
+    assert_eq!(status, 200, "{job}");
+    let job_id = job["job_id"].as_i64().unwrap();
+    let (status, body) = api
+        .post(
+            &format!("/worker/jobs/{job_id}/fail"),
+            WORKER,
+            &json!({ "lease_id": job["lease_id"], "error": error }),
+        )
+        .await;
+    assert_eq!(status, 204, "{body}");
+    job_id
+}
+
+/// Fails the test unless Chromium is installed: a dashboard test that skips itself would let a
+/// broken page pass CI.
+fn chromium() -> &'static str {
+    assert!(
+        Path::new(CHROMIUM).exists(),
+        "{CHROMIUM} is missing: the dashboard test drives headless Chromium. Install it with \
+         `apt-get install -y chromium` (.ci/run does this)."
+    );
+    CHROMIUM
+}
+
+/// Headless Chromium on `url` with `extra` flags and a fresh profile; returns stdout. Killed
+/// after two minutes so a hung browser fails the test instead of stalling it.
+fn run_chromium(dir: &Path, url: &str, extra: &[&str]) -> String {
+    let profile = tempfile::tempdir_in(dir).unwrap();
+    let out = dir.join("chromium.out");
+    let err = dir.join("chromium.err");
+    let mut child = Command::new(chromium())
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .args(extra)
+        .arg(url)
+        .stdout(std::fs::File::create(&out).unwrap())
+        .stderr(std::fs::File::create(&err).unwrap())
+        .spawn()
+        .expect("chromium starts");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "chromium did not finish in 120 s:\n{}",
+                std::fs::read_to_string(&err).unwrap_or_default()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(
+        status.success(),
+        "chromium failed ({status}):\n{}",
+        std::fs::read_to_string(&err).unwrap_or_default()
+    );
+    std::fs::read_to_string(&out).unwrap()
+}
+
+async fn wait_until(
+    api: &Api,
+    id: &str,
+    limit: Duration,
+    what: &str,
+    done: impl Fn(&Value) -> bool,
+) {
+    let start = Instant::now();
+    loop {
+        let st = api.ok(&format!("/campaigns/{id}")).await;
+        if done(&st) {
+            return;
+        }
+        assert!(
+            start.elapsed() < limit,
+            "timed out waiting for {what}: {st}"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn page_is_open_and_the_new_endpoints_list_workers_and_failed_jobs() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let (coord, url) = start_coordinator(dir.path(), 1);
+    let api = Api::new(&url);
+    let http = reqwest::Client::new();
+
+    // The page needs no token and carries no data, only the code that fetches it.
+    let id = api.submit(&campaign("endpoints", "[60]", 2, 2)).await;
+    let r = http.get(format!("{url}/")).send().await.unwrap();
+    assert_eq!(r.status().as_u16(), 200);
+    let h = r.headers();
+    assert!(h["content-type"].to_str().unwrap().starts_with("text/html"));
+    let csp = h["content-security-policy"].to_str().unwrap();
+    assert!(csp.contains("connect-src 'self'"), "{csp}");
+    let page = r.text().await.unwrap();
+    assert!(page.contains("<svg") || page.contains("createElementNS"));
+    assert!(!page.contains(&id) && !page.contains("endpoints"));
+
+    // Both endpoints take the submit token, not the worker's.
+    for path in ["/workers", &format!("/campaigns/{id}/jobs")] {
+        assert_eq!(api.get(path, None).await.0, 401, "{path}");
+        assert_eq!(api.get(path, Some(WORKER)).await.0, 401, "{path}");
+    }
+    let w = api.ok("/workers").await;
+    assert_eq!(w["workers"], json!([]), "nobody has claimed yet");
+    assert_eq!(w["lease_ttl_s"], json!(30.0));
+
+    // A worker holding a job is listed with it and its heartbeat.
+    let (status, job) = api
+        .post("/worker/claim", WORKER, &json!({ "worker": "probe-a" }))
+        .await;
+    assert_eq!(status, 200);
+    let w = api.ok("/workers").await;
+    let listed = &w["workers"][0];
+    assert_eq!(listed["name"], "probe-a", "{w}");
+    assert_eq!(listed["jobs"][0]["job_id"], job["job_id"]);
+    assert_eq!(listed["jobs"][0]["campaign_id"], json!(id));
+    assert_eq!(listed["jobs"][0]["campaign_name"], "endpoints");
+    assert_eq!(listed["jobs"][0]["angle_deg"], json!(60.0));
+    assert_eq!(listed["jobs"][0]["impacts_planned"], 2);
+    assert!(listed["jobs"][0]["last_heartbeat_ms"].as_i64().unwrap() > 0);
+    // With one attempt allowed, a reported failure fails the job for good.
+    let (status, _) = api
+        .post(
+            &format!("/worker/jobs/{}/fail", job["job_id"]),
+            WORKER,
+            &json!({ "lease_id": job["lease_id"], "error": "impact 1: negative density at particle 7" }),
+        )
+        .await;
+    assert_eq!(status, 204);
+    // An idle worker polling an empty queue is listed too, holding nothing.
+    let failed_id = job["job_id"].as_i64().unwrap();
+    let other = claim_and_fail(
+        &api,
+        "probe-b",
+        "impact 1: grain passed through the surface",
+    )
+    .await;
+    // Distinct milliseconds, so the order by last sight is certain.
+    tokio::time::sleep(Duration::from_millis(20)).await;
+    let (status, _) = api
+        .post("/worker/claim", WORKER, &json!({ "worker": "probe-idle" }))
+        .await;
+    assert_eq!(status, 204);
+    let w = api.ok("/workers").await;
+    let names: Vec<&str> = w["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names.len(), 3, "{w}");
+    assert_eq!(names[0], "probe-idle", "most recently seen first: {w}");
+    assert!(w["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|x| x["jobs"] == json!([])));
+    tokio::time::sleep(Duration::from_millis(20)).await;
+    assert_eq!(
+        api.ok("/workers?seen_within_s=0.01").await["workers"]
+            .as_array()
+            .map(Vec::len),
+        Some(0)
+    );
+
+    let failed = api.ok(&format!("/campaigns/{id}/jobs?state=failed")).await;
+    let failed = failed.as_array().unwrap();
+    assert_eq!(failed.len(), 2);
+    assert_eq!(failed[0]["job_id"], json!(failed_id));
+    assert_eq!(failed[0]["state"], "failed");
+    assert_eq!(failed[0]["attempts"], 1);
+    assert_eq!(
+        failed[0]["last_error"],
+        "impact 1: negative density at particle 7"
+    );
+    assert_eq!(failed[1]["job_id"], json!(other));
+    let all = api.ok(&format!("/campaigns/{id}/jobs?limit=1")).await;
+    assert_eq!(all.as_array().map(Vec::len), Some(1));
+    assert_eq!(
+        api.ok(&format!("/campaigns/{id}/jobs?state=done")).await,
+        json!([])
+    );
+
+    // Bad input: 422 naming the field; unknown campaign: 404.
+    for (path, field) in [
+        (format!("/campaigns/{id}/jobs?state=broken"), "state"),
+        (format!("/campaigns/{id}/jobs?limit=0"), "limit"),
+        (format!("/campaigns/{id}/jobs?limit=x"), "limit"),
+        (format!("/campaigns/{id}/jobs?colour=red"), "colour"),
+        ("/workers?seen_within_s=-1".to_string(), "seen_within_s"),
+        ("/workers?seen_within_s=NaN".to_string(), "seen_within_s"),
+        ("/workers?since=5".to_string(), "since"),
+    ] {
+        let (status, body) = api.get(&path, Some(SUBMIT)).await;
+        assert_eq!(status, 422, "{path}: {body}");
+        assert_eq!(body["field"], field, "{path}: {body}");
+    }
+    let unknown = uuid::Uuid::new_v4();
+    assert_eq!(
+        api.get(&format!("/campaigns/{unknown}/jobs"), Some(SUBMIT))
+            .await
+            .0,
+        404
+    );
+
+    // Documented in the OpenAPI document.
+    let (_, doc) = api.get("/openapi.json", None).await;
+    assert!(doc["paths"]["/api/v1/workers"]["get"].is_object());
+    assert!(doc["paths"]["/api/v1/campaigns/{id}/jobs"]["get"].is_object());
+    assert!(doc["components"]["schemas"]["WorkersResponse"].is_object());
+    let log = coord.log_text();
+    assert!(!log.contains(SUBMIT) && !log.contains(WORKER));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() {
+    let chromium_path = chromium();
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let (_coord, url) = start_coordinator(dir.path(), 1);
+    let api = Api::new(&url);
+
+    // Two angles × two samples × 20 impacts: enough for each sample's last-20 slope, so the
+    // erosion chart has a point with an error bar at each angle.
+    let id = api
+        .submit(&campaign("dashboard-e2e", "[45, 90]", 2, 20))
+        .await;
+    let worker = start_worker(dir.path(), &url, "dash-worker");
+    // While it runs, the worker is listed with the job it holds.
+    let start = Instant::now();
+    loop {
+        let w = api.ok("/workers").await;
+        if w["workers"][0]["jobs"][0]["campaign_id"] == json!(id) {
+            assert_eq!(w["workers"][0]["name"], "dash-worker");
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "{w}");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    wait_until(
+        &api,
+        &id,
+        Duration::from_secs(900),
+        "the campaign done",
+        |s| s["state"] == "done",
+    )
+    .await;
+    assert!(worker.log_text().contains("job complete"));
+    drop(worker);
+    // A second campaign whose only job fails, so the page has an error to show.
+    let failing = api
+        .submit(&campaign("dashboard-failing", "[30]", 1, 2))
+        .await;
+    claim_and_fail(
+        &api,
+        "dash-probe",
+        "impact 1: particle 42 moved more than h in one step",
+    )
+    .await;
+    wait_until(&api, &failing, Duration::from_secs(10), "failed", |s| {
+        s["state"] == "failed"
+    })
+    .await;
+    let results = api.ok(&format!("/campaigns/{id}/results")).await;
+    let with_erosion = results["cells"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["erosion_mean"].is_number())
+        .count();
+    assert_eq!(with_erosion, 2, "both cells have an erosion: {results}");
+    assert!(
+        results["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|c| c["erosion_std"].is_number()),
+        "both cells have a spread over their 2 samples: {results}"
+    );
+
+    let page = format!("{url}/#token={SUBMIT}");
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().unwrap();
+    let full = run_chromium(dir.path(), &page, &["--dump-dom"]);
+    std::fs::write(target.join("dashboard-dom.html"), &full).unwrap();
+    // What the scripts rendered, without the script's own text.
+    let dom = full.split("<script>").next().unwrap().to_string();
+    let fail = |what: &str| -> ! {
+        panic!("the rendered page lacks {what}; DOM:\n{dom}");
+    };
+    if !dom.contains(&id) || !dom.contains("dashboard-e2e") {
+        fail("the campaign's id and name");
+    }
+    if !dom.contains(">done<") || !dom.contains("80 / 80 impacts") {
+        fail("the campaign's state and progress");
+    }
+    if dom.contains("class=\"banner error\"") {
+        fail("a page without an error banner (token refused, or API unreachable)");
+    }
+    let chart = dom
+        .split("id=\"erosion-chart\"")
+        .nth(1)
+        .and_then(|rest| rest.split("</svg>").next())
+        .unwrap_or_else(|| fail("the erosion chart"));
+    if chart.matches("class=\"point\"").count() != 2 || !chart.contains("class=\"errbar\"") {
+        fail("two erosion points with error bars");
+    }
+    if !dom.contains("dash-worker") {
+        fail("the worker");
+    }
+    if !dom.contains("particle 42 moved more than h") || !dom.contains("dashboard-failing") {
+        fail("the failed job and its error");
+    }
+    assert!(
+        !full.contains(SUBMIT),
+        "the token must not be written into the page"
+    );
+
+    let png = target.join("dashboard.png");
+    let _ = std::fs::remove_file(&png);
+    run_chromium(
+        dir.path(),
+        &page,
+        &[
+            &format!("--screenshot={}", png.display()),
+            "--window-size=1280,1000",
+        ],
+    );
+    let img = image::open(&png)
+        .unwrap_or_else(|e| panic!("{}: not a PNG: {e}", png.display()))
+        .to_rgb8();
+    assert_eq!(img.dimensions(), (1280, 1000));
+    let mut colours: Vec<[u8; 3]> = img.pixels().step_by(7).map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(
+        colours.len() > 50,
+        "{} looks blank: {} colours",
+        png.display(),
+        colours.len()
+    );
+    eprintln!(
+        "dashboard screenshot (via {chromium_path}): {}",
+        png.display()
+    );
+}
