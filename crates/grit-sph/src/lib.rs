@@ -18,6 +18,7 @@ pub mod neighbours;
 pub mod particles;
 pub mod physics;
 pub mod timers;
+pub mod vtk;
 pub mod world;
 
 pub use body::{Body, BodyKind, ExternalForce, Motion, Rigid};
