@@ -293,6 +293,24 @@ pub fn run_impact(
     grain: &GrainStart,
     cancel: &dyn Fn() -> bool,
 ) -> Result<ImpactRun, ImpactError> {
+    run_impact_observed(params, surface, grain, cancel, None)
+}
+
+/// The grain's body number in an impact's world (the surface is body 0).
+pub const GRAIN_BODY: usize = 1;
+
+/// A read-only look at the world after every step of an impact (surface body 0, grain body 1).
+pub type StepObserver<'a> = &'a mut dyn FnMut(&World);
+
+/// `run_impact`, calling `observe` after every step. The observer sees the world read-only, so
+/// the impact's results are bit for bit those of `run_impact`.
+pub fn run_impact_observed(
+    params: &ImpactParams,
+    surface: &Particles,
+    grain: &GrainStart,
+    cancel: &dyn Fn() -> bool,
+    mut observe: Option<StepObserver>,
+) -> Result<ImpactRun, ImpactError> {
     let mut world = World::new(params.settings())?;
     let mut state = surface.clone();
     // Grains arrive milliseconds apart in a blasting test: the surface is at rest and at room
@@ -308,6 +326,7 @@ pub fn run_impact(
         0.0,
         Motion::Free,
     )?;
+    debug_assert_eq!(g, GRAIN_BODY, "StepObserver documents the body numbers");
     world.add_contact(
         g,
         s,
@@ -330,6 +349,9 @@ pub fn run_impact(
             return Err(ImpactError::Cancelled);
         }
         world.step()?;
+        if let Some(f) = observe.as_mut() {
+            f(&world);
+        }
         let touching = world
             .contact_forces()
             .iter()
@@ -373,6 +395,79 @@ pub fn run_impact(
         timers: world.timers().clone(),
         particles,
     })
+}
+
+/// The grain at the step of an impact when its total contact force was largest: the moment a
+/// picture of the eroded surface draws it at (seed Fig. 13 shows surface and grain together).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PeakContact {
+    /// Grain outline at that step, counter-clockwise (m).
+    pub outline_m: Vec<Vector>,
+    /// Magnitude of the grain's total contact force then (N/m, eq. 17).
+    pub force_n_m: f64,
+    /// Simulated time of that step since the impact started (s).
+    pub time_s: f64,
+    /// Lowest point of the outline below the original surface line y = 0 (m; negative when
+    /// the grain stayed above it).
+    pub depth_m: f64,
+}
+
+/// Follows an impact step by step (an observer for `run_impact_observed`) and keeps the grain's
+/// pose at the step of largest contact force: one force read and a comparison per step; the
+/// outline is built only when a larger force is seen.
+#[derive(Debug, Clone)]
+pub struct PeakTracker {
+    /// Outline vertices relative to the grain's starting centre of mass (m).
+    offsets: Vec<Vector>,
+    best_force_sq: f64,
+    peak: Option<PeakContact>,
+}
+
+impl PeakTracker {
+    /// A tracker for the impact that fires `grain`.
+    pub fn new(grain: &GrainStart) -> Self {
+        let c = grain.polygon.centroid();
+        PeakTracker {
+            offsets: grain.polygon.vertices().iter().map(|v| v - c).collect(),
+            best_force_sq: 0.0,
+            peak: None,
+        }
+    }
+
+    /// Looks at the world after one step.
+    pub fn observe(&mut self, world: &World) {
+        let Some(r) = world.bodies().get(GRAIN_BODY).and_then(|b| b.rigid()) else {
+            return;
+        };
+        let f2 = r.contact_force_n_m.norm_squared();
+        if f2 > self.best_force_sq {
+            self.best_force_sq = f2;
+            // A rigid body's centre of mass starts at its polygon's centroid with angle 0
+            // (World::add_rigid), so the outline follows from its pose alone.
+            let outline_m: Vec<Vector> = self
+                .offsets
+                .iter()
+                .map(|&o| r.com_m + grit_sph::math::rotate(o, r.angle_rad))
+                .collect();
+            let depth_m = -outline_m.iter().map(|v| v.y).fold(f64::INFINITY, f64::min);
+            self.peak = Some(PeakContact {
+                outline_m,
+                force_n_m: f2.sqrt(),
+                time_s: world.time(),
+                depth_m,
+            });
+        }
+    }
+
+    /// The grain at the largest contact force seen; `None` if it never touched.
+    pub fn peak(&self) -> Option<&PeakContact> {
+        self.peak.as_ref()
+    }
+
+    /// The grain at the largest contact force seen, taken out.
+    pub fn into_peak(self) -> Option<PeakContact> {
+        self.peak
+    }
 }
 
 /// Particles of the surface closer than this (in Δx) are connected; a lattice neighbour sits

@@ -7,7 +7,9 @@ use rand_core::{RngCore, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use crate::aggregate::Impact;
-use crate::impact::{run_impact, GrainStart, ImpactError, ImpactOutcome, ImpactParams};
+use crate::impact::{
+    run_impact_observed, GrainStart, ImpactError, ImpactOutcome, ImpactParams, StepObserver,
+};
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
@@ -157,13 +159,25 @@ impl Sample {
         &mut self,
         cancel: &dyn Fn() -> bool,
     ) -> Result<&ImpactRecord, SampleError> {
+        self.run_next_observed(cancel, None)
+    }
+
+    /// `run_next_cancellable`, with `observe` called after every step of the impact (to catch
+    /// the grain at its peak contact force for a picture, say: `PeakTracker`). The observer
+    /// reads only, so the sample goes on bit for bit as without it.
+    pub fn run_next_observed(
+        &mut self,
+        cancel: &dyn Fn() -> bool,
+        observe: Option<StepObserver>,
+    ) -> Result<&ImpactRecord, SampleError> {
         let k = self.impacts_done();
         let err = |error: ImpactError| SampleError::Impact {
             impact: k + 1,
             error,
         };
         let grain = self.next_grain().map_err(|e| err(e.into()))?;
-        let run = run_impact(&self.params, &self.surface, &grain, cancel).map_err(err)?;
+        let run = run_impact_observed(&self.params, &self.surface, &grain, cancel, observe)
+            .map_err(err)?;
         self.last_timers = run.timers;
         self.last_particles = run.particles;
         let outcome = run.outcome;
@@ -230,5 +244,61 @@ impl Sample {
             last_timers: Timers::default(),
             last_particles: 0,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Watching a sample's impacts (for snapshots) leaves its results bit for bit unchanged.
+
+    use super::*;
+    use crate::impact::PeakTracker;
+
+    /// A coarse scene (10 particles per Dg, 2 × 1.25 Dg surface) that runs in seconds.
+    fn coarse() -> ImpactParams {
+        ImpactParams {
+            spacing_m: 25e-6,
+            surface_width_dg: 2.0,
+            surface_depth_dg: 1.25,
+            distribution_range_dg: 0.0,
+            ..ImpactParams::default()
+        }
+    }
+
+    #[test]
+    fn observing_impacts_changes_no_bit() {
+        let mut plain = Sample::new(coarse(), 7).unwrap();
+        let mut watched = Sample::new(coarse(), 7).unwrap();
+        for k in 1..=2 {
+            plain.run_next().unwrap();
+            let grain = watched.next_grain().unwrap();
+            let mut tracker = PeakTracker::new(&grain);
+            let mut steps = 0u64;
+            watched
+                .run_next_observed(
+                    &|| false,
+                    Some(&mut |w| {
+                        steps += 1;
+                        tracker.observe(w)
+                    }),
+                )
+                .unwrap();
+            let rec = &watched.records()[k - 1];
+            assert_eq!(steps, rec.outcome.steps, "observer runs once a step");
+            let peak = tracker.into_peak().expect("the grain touched the surface");
+            assert!(peak.force_n_m > 0.0 && peak.time_s > 0.0);
+            assert!(peak.time_s <= rec.outcome.sim_time_s);
+            assert_eq!(peak.outline_m.len(), 6, "hexagon");
+            // At peak force a normal impact has pushed the grain into the surface.
+            assert!(peak.depth_m > 0.0, "depth {:e}", peak.depth_m);
+            let centre = peak.outline_m.iter().sum::<grit_sph::Vector>() / 6.0;
+            assert!(centre.x.abs() < 0.1 * plain.params().grain_diameter_m);
+        }
+        assert_eq!(plain.records(), watched.records());
+        assert_eq!(
+            plain.checkpoint(),
+            watched.checkpoint(),
+            "surface state differs"
+        );
     }
 }
