@@ -14,6 +14,7 @@ mod charts;
 mod draw;
 mod fonts;
 mod input;
+mod surface;
 
 use std::path::{Path, PathBuf};
 
@@ -22,6 +23,7 @@ use grit_erosion::CampaignResults;
 pub use draw::colour;
 pub use fonts::register_fonts;
 pub use input::{load, merge, parse, PlotInput, RawImpact, RawSeries};
+pub use surface::{surface_png, viridis, SurfaceField, SurfacePicture};
 
 /// Why charts could not be made: unreadable or invalid input, or an unwritable output.
 #[derive(Debug, thiserror::Error)]
