@@ -1,12 +1,14 @@
 //! `grit shapes` and `grit sample`: the grain shape factors (seed Table 2) and one sample of
 //! sequential random impacts run locally (seed section 4).
 
-use std::path::PathBuf;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{bail, Context};
 use grit_erosion::aggregate::{cumulative_series, sample_erosion};
+use grit_erosion::impact::{PeakContact, PeakTracker};
 use grit_erosion::{ImpactParams, Sample, Shape, SLOPE_WINDOW};
 use serde::Serialize;
 
@@ -144,6 +146,172 @@ pub struct SampleArgs {
     /// database) with the parameters and seed stored in it; `--impacts` is then the total.
     #[arg(long)]
     resume: Option<PathBuf>,
+    /// Write pictures of the surface (PNG, coloured by damage and by plastic strain, with the
+    /// grain at its largest contact force) and ParaView files (VTU, PVD) after chosen impacts
+    /// into this folder (docs/snapshots.md).
+    #[arg(long, value_name = "DIR")]
+    snapshots: Option<PathBuf>,
+    /// Impacts to snapshot, 1-based and comma-separated [default: the first, every 10th and
+    /// the last].
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "snapshots",
+        value_name = "K,..."
+    )]
+    snapshot_at: Option<Vec<u32>>,
+}
+
+/// Where `--snapshots` writes, which impacts it takes, and what it has written so far.
+struct Snapshots {
+    dir: PathBuf,
+    at: BTreeSet<u32>,
+    /// Digits of the impact number in file names, so they sort in impact order.
+    width: usize,
+    /// (impact, surface file, grain file if the grain touched) of every snapshot written.
+    written: Vec<(u32, String, Option<String>)>,
+}
+
+impl Snapshots {
+    /// Checks the flags before any impact runs: the impacts are this run's and the folder
+    /// takes files.
+    fn new(dir: &Path, at: Option<&[u32]>, done: u32, impacts: u32) -> anyhow::Result<Self> {
+        let at: BTreeSet<u32> = match at {
+            Some(list) => {
+                for &k in list {
+                    if k == 0 || k > impacts {
+                        bail!(
+                            "--snapshot-at: impact {k} is not one of this run's impacts 1..={impacts} (--impacts)"
+                        );
+                    }
+                    if k <= done {
+                        bail!(
+                            "--snapshot-at: impact {k} was finished before the checkpoint, which holds {done} impacts"
+                        );
+                    }
+                }
+                list.iter().copied().collect()
+            }
+            None => std::iter::once(1)
+                .chain((10..=impacts).step_by(10))
+                .chain(std::iter::once(impacts))
+                .filter(|&k| k > done)
+                .collect(),
+        };
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--snapshots {}: cannot create the folder", dir.display()))?;
+        let s = Snapshots {
+            dir: dir.to_path_buf(),
+            at,
+            width: impacts.to_string().len().max(4),
+            written: Vec::new(),
+        };
+        // Empty collections now: an unwritable folder fails before hours of simulation.
+        s.write_collections()
+            .with_context(|| format!("--snapshots {}: cannot write there", dir.display()))?;
+        Ok(s)
+    }
+
+    fn wants(&self, impact: u32) -> bool {
+        self.at.contains(&impact)
+    }
+
+    fn write_collections(&self) -> std::io::Result<()> {
+        let surface: Vec<(f64, &str)> = self
+            .written
+            .iter()
+            .map(|(k, f, _)| (*k as f64, f.as_str()))
+            .collect();
+        let grain: Vec<(f64, &str)> = self
+            .written
+            .iter()
+            .filter_map(|(k, _, g)| g.as_deref().map(|g| (*k as f64, g)))
+            .collect();
+        for (name, entries) in [("surface.pvd", surface), ("grain.pvd", grain)] {
+            let f = std::fs::File::create(self.dir.join(name))?;
+            grit_sph::vtk::write_collection(f, &entries)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the pictures and ParaView files of the surface as `s` holds it after its last
+    /// impact, with the grain at `peak`.
+    fn write(&mut self, s: &Sample, peak: Option<&PeakContact>) -> anyhow::Result<()> {
+        let k = s.impacts_done();
+        let p = s.params();
+        let tag = format!("{k:0w$}", w = self.width);
+        let in_dir = |name: &str| self.dir.join(name);
+        let create = |name: &str| {
+            std::fs::File::create(in_dir(name))
+                .with_context(|| format!("--snapshots: writing {}", in_dir(name).display()))
+        };
+
+        let surface_file = format!("surface-{tag}.vtu");
+        grit_sph::vtk::write_particles(
+            create(&surface_file)?,
+            s.surface(),
+            &[p.material.bulk_modulus()],
+        )
+        .with_context(|| format!("--snapshots: writing {surface_file}"))?;
+        let grain_file = match peak {
+            Some(pk) => {
+                let name = format!("grain-{tag}.vtu");
+                grit_sph::vtk::write_polygon(create(&name)?, &pk.outline_m)
+                    .with_context(|| format!("--snapshots: writing {name}"))?;
+                Some(name)
+            }
+            None => None,
+        };
+
+        let um = 1e6;
+        let lost: f64 = s.records().iter().map(|r| r.mass_loss_kg).sum();
+        let removed: u32 = s
+            .records()
+            .iter()
+            .map(|r| r.outcome.removed_particles + r.outcome.detached_particles)
+            .sum();
+        let grain_note = match peak {
+            Some(pk) => format!(
+                "grey: the grain at its largest contact force in impact {k}, {:.3e} N/m at {:.2} µs; \
+                 its lowest point {:.1} µm below the original surface (y = 0)",
+                pk.force_n_m,
+                pk.time_s * um,
+                pk.depth_m * um
+            ),
+            None => format!("the grain of impact {k} never touched the surface"),
+        };
+        let picture = grit_plot::SurfacePicture {
+            particles: s.surface(),
+            spacing_m: p.spacing_m,
+            outline_m: peak.map(|pk| pk.outline_m.as_slice()),
+            title: format!(
+                "after impact {k}, {}° {}, {} m/s, Δx {} µm, seed {}",
+                p.angle_deg,
+                p.shape.name(),
+                p.velocity_m_s,
+                p.spacing_m * um,
+                s.seed()
+            ),
+            notes: vec![
+                grain_note,
+                if removed == 0 {
+                    format!("no surface mass lost in impacts 1-{k}; pale: the fixed particles that hold the surface")
+                } else {
+                    format!(
+                        "surface mass lost in impacts 1-{k}: {lost:.3e} kg per m of depth \
+                         ({removed} particles); pale: the fixed particles that hold the surface"
+                    )
+                },
+            ],
+        };
+        for field in grit_plot::SurfaceField::ALL {
+            let path = in_dir(&format!("{}-{tag}.png", field.stem()));
+            grit_plot::surface_png(&picture, field, &path)?;
+        }
+        self.written.push((k, surface_file, grain_file));
+        self.write_collections()
+            .with_context(|| format!("--snapshots: writing {}", self.dir.display()))
+    }
 }
 
 fn pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
@@ -204,16 +372,40 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             s.impacts_done()
         );
     }
+    let mut snapshots = match &a.snapshots {
+        Some(dir) => Some(Snapshots::new(
+            dir,
+            a.snapshot_at.as_deref(),
+            s.impacts_done(),
+            a.impacts,
+        )?),
+        None => None,
+    };
     let pool = pool(a.threads)?;
     let bar = impact_bar(a.impacts)?;
     bar.set_position(s.impacts_done() as u64);
     let t0 = Instant::now();
     let mut failure = None;
     for _ in s.impacts_done()..a.impacts {
-        if let Err(e) = pool.install(|| s.run_next().map(|_| ())) {
+        let k = s.impacts_done() + 1;
+        // Only a snapshot impact is watched, so the others run exactly as without --snapshots.
+        let mut tracker = match &snapshots {
+            Some(snap) if snap.wants(k) => Some(PeakTracker::new(&s.next_grain()?)),
+            _ => None,
+        };
+        let ran = pool.install(|| match tracker.as_mut() {
+            Some(t) => s
+                .run_next_observed(&|| false, Some(&mut |w| t.observe(w)))
+                .map(|_| ()),
+            None => s.run_next().map(|_| ()),
+        });
+        if let Err(e) = ran {
             // Keep what the finished impacts found: they are written below, then the error.
             failure = Some(e);
             break;
+        }
+        if let (Some(snap), Some(t)) = (snapshots.as_mut(), tracker) {
+            snap.write(&s, t.peak())?;
         }
         bar.set_message(format!(
             "loss so far {:.3e} kg/m",
@@ -274,6 +466,13 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             None => println!("erosion: needs at least {SLOPE_WINDOW} impacts"),
         }
         println!("wall time {:.1} s", t0.elapsed().as_secs_f64());
+        if let Some(snap) = &snapshots {
+            println!(
+                "snapshots of {} impacts in {} (surface.pvd and grain.pvd open in ParaView)",
+                snap.written.len(),
+                snap.dir.display()
+            );
+        }
     }
     if let Some(e) = failure {
         return Err(anyhow::Error::from(e).context(format!(
