@@ -204,3 +204,43 @@ fn bad_snapshot_flags_are_refused_by_name() {
         "a refused run wrote files"
     );
 }
+
+#[test]
+fn resumed_sample_snapshots_only_impacts_still_to_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Sample::new(params(), 1).unwrap();
+    s.run_next().unwrap();
+    let ckpt = dir.path().join("ckpt.bin");
+    std::fs::write(&ckpt, s.checkpoint()).unwrap();
+    let snap = dir.path().join("snap");
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_grit"))
+            .args([
+                "sample",
+                "--resume",
+                ckpt.to_str().unwrap(),
+                "--impacts",
+                "2",
+            ])
+            .args(["--snapshots", snap.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--snapshot-at", "1"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--snapshot-at: impact 1 was finished before the checkpoint"),
+        "{err}"
+    );
+    // The default set (first and last) keeps only the impact this run makes.
+    let out = run(&[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(snap.join("damage-0002.png").exists());
+    assert!(!snap.join("damage-0001.png").exists());
+}
