@@ -221,13 +221,19 @@ fn modified(series: &[Series]) -> Result<Modified, String> {
     let points: Vec<ShapedPoint> = shown
         .iter()
         .flat_map(|&(i, (e, an))| {
-            series[i].points.iter().map(move |p| ShapedPoint {
-                angle_deg: p.angle_deg,
-                aspect_ratio: e,
-                angularity: an,
-                erosion: p.mean,
-                weight: 1.0,
-            })
+            // A cell with no loss at all is below what the resolution can show, not an
+            // erosion of zero: the log-space fit cannot take it, so it is left out.
+            series[i]
+                .points
+                .iter()
+                .filter(|p| p.mean > 0.0)
+                .map(move |p| ShapedPoint {
+                    angle_deg: p.angle_deg,
+                    aspect_ratio: e,
+                    angularity: an,
+                    erosion: p.mean,
+                    weight: 1.0,
+                })
         })
         .collect();
     let reference = ShapeReference::HEXAGON;
