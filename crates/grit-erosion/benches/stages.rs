@@ -7,8 +7,9 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use grit_erosion::impact::impact_world;
 use grit_erosion::{ImpactParams, Shape};
-use grit_sph::{ContactModel, ContactParams, Motion, Stage, World};
+use grit_sph::{Stage, World};
 
 /// The impact scene at `spacing_m`, stepped until the grain has pressed into the surface for
 /// `contact_steps` steps.
@@ -19,30 +20,7 @@ fn mid_contact(spacing_m: f64, contact_steps: u32) -> World {
     };
     let surface = params.fresh_surface().expect("valid scene");
     let grain = params.grain_start(0.3, 0.5).expect("valid grain");
-    let mut w = World::new(params.settings()).expect("valid settings");
-    let s = w
-        .add_deformable_state("surface", params.material.clone(), surface, Motion::Fixed)
-        .expect("surface");
-    let g = w
-        .add_rigid(
-            "grain",
-            &grain.polygon,
-            params.grain_density_kg_m3,
-            grain.velocity_m_s,
-            0.0,
-            Motion::Free,
-        )
-        .expect("grain");
-    w.add_contact(
-        g,
-        s,
-        ContactParams {
-            model: ContactModel::Extrapolated,
-            friction: params.friction,
-            ..Default::default()
-        },
-    )
-    .expect("contact");
+    let mut w = impact_world(&params, &surface, &grain).expect("valid scene");
     let mut touching = 0;
     while touching < contact_steps {
         w.step().expect("stable");

@@ -299,18 +299,16 @@ pub fn run_impact(
 /// The grain's body number in an impact's world (the surface is body 0).
 pub const GRAIN_BODY: usize = 1;
 
-/// A read-only look at the world after every step of an impact (surface body 0, grain body 1).
-pub type StepObserver<'a> = &'a mut dyn FnMut(&World);
+/// The surface's body number in an impact's world.
+pub const SURFACE_BODY: usize = 0;
 
-/// `run_impact`, calling `observe` after every step. The observer sees the world read-only, so
-/// the impact's results are bit for bit those of `run_impact`.
-pub fn run_impact_observed(
+/// The world of one impact before its first step (seed section 4): the surface at rest and at
+/// room temperature, the grain free, and the seed's contact between them (eqs. 21–29).
+pub fn impact_world(
     params: &ImpactParams,
     surface: &Particles,
     grain: &GrainStart,
-    cancel: &dyn Fn() -> bool,
-    mut observe: Option<StepObserver>,
-) -> Result<ImpactRun, ImpactError> {
+) -> Result<World, InputError> {
     let mut world = World::new(params.settings())?;
     let mut state = surface.clone();
     // Grains arrive milliseconds apart in a blasting test: the surface is at rest and at room
@@ -326,7 +324,11 @@ pub fn run_impact_observed(
         0.0,
         Motion::Free,
     )?;
-    debug_assert_eq!(g, GRAIN_BODY, "StepObserver documents the body numbers");
+    debug_assert_eq!(
+        (s, g),
+        (SURFACE_BODY, GRAIN_BODY),
+        "the body numbers are documented"
+    );
     world.add_contact(
         g,
         s,
@@ -336,6 +338,23 @@ pub fn run_impact_observed(
             ..Default::default()
         },
     )?;
+    Ok(world)
+}
+
+/// A read-only look at the world after every step of an impact (surface body 0, grain body 1).
+pub type StepObserver<'a> = &'a mut dyn FnMut(&World);
+
+/// `run_impact`, calling `observe` after every step. The observer sees the world read-only, so
+/// the impact's results are bit for bit those of `run_impact`.
+pub fn run_impact_observed(
+    params: &ImpactParams,
+    surface: &Particles,
+    grain: &GrainStart,
+    cancel: &dyn Fn() -> bool,
+    mut observe: Option<StepObserver>,
+) -> Result<ImpactRun, ImpactError> {
+    let mut world = impact_world(params, surface, grain)?;
+    let (s, g) = (SURFACE_BODY, GRAIN_BODY);
     let e0 = world.energy().kinetic;
     let particles = world.particles().len();
     let dg = params.grain_diameter_m;
