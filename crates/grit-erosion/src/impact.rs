@@ -204,10 +204,20 @@ impl ImpactParams {
         let aim_x = (u_aim - 0.5) * self.distribution_range_dg * self.grain_diameter_m;
         let a = self.angle_deg.to_radians();
         let dir = Vector::new(a.cos(), -a.sin());
-        // The centroid path crosses the surface line y = 0 at the aim point; back the grain up
-        // along its path until its lowest point is START_GAP_DX above the surface.
+        // Seed section 4: oblique grains are "shifted accordingly so that they hit the surface
+        // around the midpoint". So the centroid is above the aim point when the lowest point
+        // reaches y = 0. (Aiming the centroid path at y = 0 instead puts the touchdown
+        // |lowest| / tan α upstream: 1.9 Dg at 15°, off a 2.5 Dg surface.) From there the
+        // grain is backed up along its path until its lowest point is START_GAP_DX above the
+        // surface. At 90° the shift is zero; it is skipped there so normal-incidence results
+        // keep their bits.
+        let shift = if self.angle_deg == 90.0 {
+            0.0
+        } else {
+            -lowest / a.tan()
+        };
         let back = (START_GAP_DX * self.spacing_m - lowest) / a.sin();
-        let centre = Vector::new(aim_x, 0.0) - dir * back;
+        let centre = Vector::new(aim_x + shift, 0.0) - dir * back;
         let vertices: Vec<[f64; 2]> = rotated
             .iter()
             .map(|v| [v.x + centre.x, v.y + centre.y])
@@ -377,7 +387,10 @@ pub fn run_impact_observed(
             .any(|f| f.x != 0.0 || f.y != 0.0);
         quiet = if touching { 0 } else { quiet + 1 };
         let r = world.bodies()[g].rigid().expect("grain is rigid");
-        let away = r.velocity_m_s.y > 0.0 || r.com_m.x.abs() > half_width + dg;
+        // Past a side edge counts only while moving outward: a grazing grain can start
+        // beyond the edge and fly in.
+        let beyond = r.com_m.x.abs() > half_width + dg && r.com_m.x * r.velocity_m_s.x > 0.0;
+        let away = r.velocity_m_s.y > 0.0 || beyond;
         if quiet >= SEPARATED_STEPS && away && quiet.is_multiple_of(10) {
             // Flying fragments would hold the surface's kinetic energy up forever.
             let keep = attached(&world, s, DETACH_LINK_DX * params.spacing_m);
