@@ -1,5 +1,5 @@
 //! Elastic impact energy with filter/hourglass and the disc switched:
-//! `cargo run --release --example impact2 -- N FILTER_EVERY HOURGLASS [RADIUS_M SPEED_M_S DENSITY]`.
+//! `cargo run --release --example impact2 -- N FILTER_EVERY HOURGLASS [RADIUS_M SPEED_M_S DENSITY [shepard|mls]]`.
 use grit_sph::verification::elastic_impact::{simulate_with, Disc};
 
 fn main() {
@@ -9,6 +9,10 @@ fn main() {
     let s = grit_sph::Settings {
         shepard_interval: arg(2).expect("FILTER_EVERY") as u32,
         hourglass: arg(3).expect("HOURGLASS"),
+        density_filter: match a.get(7).map(String::as_str) {
+            Some("mls") => grit_sph::DensityFilter::Mls,
+            _ => grit_sph::DensityFilter::Shepard,
+        },
         ..Default::default()
     };
     let d = Disc::default();

@@ -34,6 +34,8 @@ pub struct Settings {
     pub hourglass: f64,
     /// Steps between Shepard density filters (eq. 12; seed: 40; 0 switches it off).
     pub shepard_interval: u32,
+    /// Which density filter runs every `shepard_interval` steps (seed: Shepard, eq. 12).
+    pub density_filter: DensityFilter,
     /// Verlet skin over Δx: lists are rebuilt once a particle has moved half of it.
     pub skin_over_dx: f64,
     /// Upper bound of the time step (s).
@@ -54,6 +56,7 @@ impl Default for Settings {
             gravity_m_s2: Vector::zeros(),
             hourglass: 0.1,
             shepard_interval: 40,
+            density_filter: DensityFilter::Shepard,
             skin_over_dx: 0.5,
             dt_max_s: 1e-3,
             taylor_quinney: 0.9,
@@ -95,6 +98,20 @@ impl Settings {
         }
         Ok(())
     }
+}
+
+/// The periodic density re-initialisation: the seed's zeroth-order Shepard average (eq. 12), or
+/// its first-order moving-least-squares form (Colagrossi & Landrini 2003, Dilts 1999).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DensityFilter {
+    /// Eq. 12: a kernel-weighted average. It flattens any density gradient over a kernel
+    /// width, so it also damps resolved elastic waves, and most at a free surface.
+    #[default]
+    Shepard,
+    /// Eq. 12 with the kernel corrected to reproduce linear fields, at free surfaces too: it
+    /// removes particle-scale noise and leaves resolved strain gradients almost untouched.
+    Mls,
 }
 
 /// Energy of the world and what the numerics have added or taken (J/m, per unit depth).
@@ -1433,9 +1450,7 @@ impl World {
     fn housekeeping(&mut self, bc: &[BodyConst]) -> Result<(), SimError> {
         let every = self.settings.shepard_interval as u64;
         if every > 0 && self.steps.is_multiple_of(every) {
-            let before = self.energy().elastic;
-            self.shepard_filter(bc);
-            self.work.density_filter += self.energy().elastic - before;
+            self.filter_density_with(bc);
         }
         let failed: Vec<bool> = self.particles.damage.iter().map(|&d| d >= 1.0).collect();
         if failed.iter().any(|&f| f) {
@@ -1453,7 +1468,20 @@ impl World {
         Ok(())
     }
 
-    /// ρ_i = Σ m_j W_ij / Σ V_j W_ij over the body, self included (eq. 12).
+    /// Runs the configured density filter now (eq. 12, or its MLS form) and books the change
+    /// of elastic energy as the filter's work; `step` calls it every `shepard_interval` steps.
+    pub fn filter_density(&mut self) {
+        let bc = self.body_consts();
+        self.filter_density_with(&bc);
+    }
+
+    fn filter_density_with(&mut self, bc: &[BodyConst]) {
+        let before = self.energy().elastic;
+        self.shepard_filter(bc);
+        self.work.density_filter += self.energy().elastic - before;
+    }
+
+    /// ρ_i = Σ m_j W_ij / Σ V_j W_ij over the body, self included (eq. 12), or its MLS form.
     fn shepard_filter(&mut self, bc: &[BodyConst]) {
         if !self.nbrs_valid || self.nbrs.start.len() != self.particles.len() + 1 {
             self.rebuild_neighbours();
@@ -1462,6 +1490,7 @@ impl World {
         let nl = &self.nbrs;
         let k = &self.kernel;
         let w0 = k.w(0.0);
+        let mls = self.settings.density_filter == DensityFilter::Mls;
         let rho: Vec<f64> = (0..p.len())
             .into_par_iter()
             .with_min_len(MIN_LEN)
@@ -1469,6 +1498,11 @@ impl World {
                 let bi = p.body[i];
                 if !bc[bi as usize].deformable {
                     return p.rho[i];
+                }
+                if mls {
+                    if let Some(r) = mls_density(p, nl, k, i) {
+                        return r;
+                    }
                 }
                 let (mut num, mut den) = (p.mass[i] * w0, p.mass[i] / p.rho[i] * w0);
                 for Pair { j, w, .. } in body_pairs(p, nl, k, i) {
@@ -1480,6 +1514,35 @@ impl World {
             .collect();
         self.particles.rho = rho;
     }
+}
+
+/// First-order MLS density at particle `i` (Colagrossi & Landrini 2003): ρ_i = Σ_j m_j W_ij
+/// (β0 + β·x_ji), with β solving the moment system Σ_j V_j W_ij [1 x_ji]ᵀ[1 x_ji] β = e1, so a
+/// linear density field comes back exactly. None where the system is near-singular (a particle
+/// with neighbours on a line), which then falls back to eq. 12.
+fn mls_density(p: &Particles, nl: &NeighbourLists, k: &Kernel, i: usize) -> Option<f64> {
+    use nalgebra::{Matrix3, Vector3};
+    // Offsets in units of h keep the moment matrix well scaled.
+    let inv_h = 1.0 / k.h;
+    let w0 = k.w(0.0);
+    let mut a = Matrix3::zeros();
+    let vi = p.mass[i] / p.rho[i];
+    a[(0, 0)] = vi * w0;
+    for Pair { j, xij, w, .. } in body_pairs(p, nl, k, i) {
+        let q = Vector3::new(1.0, -xij.x * inv_h, -xij.y * inv_h);
+        a += q * q.transpose() * (p.mass[j] / p.rho[j] * w);
+    }
+    // Relative to the zeroth moment: below this the linear terms are not determined.
+    if a.determinant() <= 1e-6 * a[(0, 0)].powi(3) {
+        return None;
+    }
+    let beta = a.try_inverse()?.column(0).into_owned();
+    let mut rho = p.mass[i] * w0 * beta[0];
+    for Pair { j, xij, w, .. } in body_pairs(p, nl, k, i) {
+        let q = Vector3::new(1.0, -xij.x * inv_h, -xij.y * inv_h);
+        rho += p.mass[j] * w * beta.dot(&q);
+    }
+    (rho.is_finite() && rho > 0.0).then_some(rho)
 }
 
 impl Scratch {
