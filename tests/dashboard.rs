@@ -6,93 +6,33 @@
 //! fresh SQLite file per test, real (coarse) SPH impacts. TEST_LOG=1 prints the processes'
 //! logs.
 
-use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::path::Path;
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use serde_json::{json, Value};
 
-const GRIT: &str = env!("CARGO_BIN_EXE_grit");
+mod common;
+use common::{campaign, Proc, SERIAL, SUBMIT, WORKER};
+
 const CHROMIUM: &str = "/usr/bin/chromium";
-const SUBMIT: &str = "dashboard-submit-token";
-const WORKER: &str = "dashboard-worker-token";
-
-/// The tests share two cores and time leases, so they run one at a time.
-static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
-
-/// The coarsest real scene of tests/farm.rs: 10 particles per grain diameter on a small
-/// surface, with `impacts` per sample.
-fn campaign(name: &str, angles: &str, samples: u32, impacts: u32) -> String {
-    format!(
-        r#"{{"name": "{name}", "seed": 11, "angles_deg": {angles}, "shapes": ["hexagon"],
-            "samples": {samples}, "impacts": {impacts}, "allow_short_samples": true,
-            "spacing_m": 25e-6, "surface_width_dg": 3.0, "surface_depth_dg": 1.3}}"#
-    )
-}
-
-/// A child process killed on drop, with its log in a file.
-struct Proc {
-    child: Child,
-    log: PathBuf,
-}
-
-impl Proc {
-    fn log_text(&self) -> String {
-        std::fs::read_to_string(&self.log).unwrap_or_default()
-    }
-}
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        if std::env::var_os("TEST_LOG").is_some() {
-            eprintln!("--- {} ---\n{}", self.log.display(), self.log_text());
-        }
-    }
-}
 
 /// `grit serve` on a free loopback port; returns the process and its base URL.
 fn start_coordinator(dir: &Path, max_attempts: u32) -> (Proc, String) {
-    let log = dir.join("coordinator.log");
-    let mut child = Command::new(GRIT)
-        .args(["serve", "--db"])
-        .arg(dir.join("farm.db"))
-        .args(["--listen", "127.0.0.1:0", "--lease-ttl-s", "30"])
-        .args(["--max-attempts", &max_attempts.to_string()])
-        .env("GRIT_SUBMIT_TOKEN", SUBMIT)
-        .env("GRIT_WORKER_TOKEN", WORKER)
-        .env("RUST_LOG", "info")
-        .stdout(Stdio::piped())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .expect("grit serve starts");
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let url = line
-        .trim()
-        .rsplit(' ')
-        .next()
-        .filter(|u| u.starts_with("http://"))
-        .unwrap_or_else(|| panic!("no address line from grit serve: {line:?}"))
-        .to_string();
-    (Proc { child, log }, url)
+    let attempts = max_attempts.to_string();
+    let args = [
+        "--listen",
+        "127.0.0.1:0",
+        "--lease-ttl-s",
+        "30",
+        "--max-attempts",
+        &attempts,
+    ];
+    common::start_coordinator(dir, "a", &args)
 }
 
 fn start_worker(dir: &Path, url: &str, name: &str) -> Proc {
-    let log = dir.join(format!("worker-{name}.log"));
-    let child = Command::new(GRIT)
-        .args(["work", "--coordinator", url, "--token", WORKER])
-        .args(["--threads", "1", "--poll-s", "0.2", "--name", name])
-        .env("RUST_LOG", "info")
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .expect("grit work starts");
-    Proc { child, log }
+    common::start_worker(dir, url, name, &[])
 }
 
 /// A small HTTP helper: JSON calls with a bearer token, answering (status, body).

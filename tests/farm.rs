@@ -2,9 +2,8 @@
 //! workers over loopback, a fresh SQLite file per test, and real (coarse) SPH impacts.
 //! Set TEST_LOG=1 to see the processes' logs on failure paths.
 
-use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::path::Path;
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use grit_erosion::ImpactRecord;
@@ -13,46 +12,14 @@ use grit_farm::{Client, Secret};
 use serde_json::Value;
 use uuid::Uuid;
 
-const GRIT: &str = env!("CARGO_BIN_EXE_grit");
-const SUBMIT: &str = "submit-token-for-tests";
-const WORKER: &str = "worker-token-for-tests";
+mod common;
+use common::{
+    campaign as spec_of, start_worker as spawn_worker, Proc, GRIT, SERIAL, SUBMIT, WORKER,
+};
 
-/// The tests share two cores and time leases, so they run one at a time (a tokio mutex: the
-/// guard is held across awaits, and a failed test must not poison it for the others).
-static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
-
-/// The coarsest real scene: 10 particles per grain diameter on a small surface.
+/// The coarsest real scene at 60°.
 fn campaign(samples: u32, impacts: u32) -> String {
-    format!(
-        r#"{{"name": "e2e", "seed": 11, "angles_deg": [60], "shapes": ["hexagon"],
-            "samples": {samples}, "impacts": {impacts}, "allow_short_samples": true,
-            "spacing_m": 25e-6, "surface_width_dg": 3.0, "surface_depth_dg": 1.3}}"#
-    )
-}
-
-struct Proc {
-    child: Child,
-    log: PathBuf,
-}
-
-impl Proc {
-    fn log_text(&self) -> String {
-        std::fs::read_to_string(&self.log).unwrap_or_default()
-    }
-
-    fn kill9(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        self.kill9();
-        if std::env::var_os("TEST_LOG").is_some() {
-            eprintln!("--- {} ---\n{}", self.log.display(), self.log_text());
-        }
-    }
+    spec_of("e2e", "[60]", samples, impacts)
 }
 
 struct Coordinator {
@@ -61,59 +28,22 @@ struct Coordinator {
 }
 
 fn start_coordinator(dir: &Path, listen: &str, lease_ttl_s: f64, tag: &str) -> Coordinator {
-    let log = dir.join(format!("coordinator-{tag}.log"));
-    let mut child = Command::new(GRIT)
-        .args(["serve", "--db"])
-        .arg(dir.join("farm.db"))
-        .args([
-            "--listen",
-            listen,
-            "--lease-ttl-s",
-            &lease_ttl_s.to_string(),
-        ])
-        .args(["--max-spec-bytes", "65536"])
-        .env("GRIT_SUBMIT_TOKEN", SUBMIT)
-        .env("GRIT_WORKER_TOKEN", WORKER)
-        .env("RUST_LOG", "info")
-        .stdout(Stdio::piped())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .expect("grit serve starts");
-    let stdout = child.stdout.take().unwrap();
-    let mut line = String::new();
-    BufReader::new(stdout).read_line(&mut line).unwrap();
-    let url = line
-        .trim()
-        .rsplit(' ')
-        .next()
-        .filter(|u| u.starts_with("http://"))
-        .unwrap_or_else(|| panic!("no address line from grit serve: {line:?}"))
-        .to_string();
-    Coordinator {
-        proc: Proc { child, log },
-        url,
-    }
+    let ttl = lease_ttl_s.to_string();
+    let args = [
+        "--listen",
+        listen,
+        "--lease-ttl-s",
+        &ttl,
+        "--max-spec-bytes",
+        "65536",
+    ];
+    let (proc, url) = common::start_coordinator(dir, tag, &args);
+    Coordinator { proc, url }
 }
 
+/// A worker that checkpoints after every impact, so a kill loses at most one.
 fn start_worker(dir: &Path, url: &str, tag: &str) -> Proc {
-    let log = dir.join(format!("worker-{tag}.log"));
-    let child = Command::new(GRIT)
-        .args(["work", "--coordinator", url, "--token", WORKER])
-        .args([
-            "--threads",
-            "1",
-            "--checkpoint-every",
-            "1",
-            "--poll-s",
-            "0.2",
-        ])
-        .args(["--name", tag])
-        .env("RUST_LOG", "info")
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .expect("grit work starts");
-    Proc { child, log }
+    spawn_worker(dir, url, tag, &["--checkpoint-every", "1"])
 }
 
 fn submitter(url: &str) -> Client {
