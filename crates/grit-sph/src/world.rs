@@ -1525,23 +1525,23 @@ fn mls_density(p: &Particles, nl: &NeighbourLists, k: &Kernel, i: usize) -> Opti
     // Offsets in units of h keep the moment matrix well scaled.
     let inv_h = 1.0 / k.h;
     let w0 = k.w(0.0);
+    // ρ_i is linear in β, so one pass gathers both the moments A and b = Σ_j m_j W_ij q_j,
+    // and ρ_i = β·b.
     let mut a = Matrix3::zeros();
-    let vi = p.mass[i] / p.rho[i];
-    a[(0, 0)] = vi * w0;
+    let mut b = Vector3::zeros();
+    a[(0, 0)] = p.mass[i] / p.rho[i] * w0;
+    b[0] = p.mass[i] * w0;
     for Pair { j, xij, w, .. } in body_pairs(p, nl, k, i) {
         let q = Vector3::new(1.0, -xij.x * inv_h, -xij.y * inv_h);
         a += q * q.transpose() * (p.mass[j] / p.rho[j] * w);
+        b += q * (p.mass[j] * w);
     }
     // Relative to the zeroth moment: below this the linear terms are not determined.
     if a.determinant() <= 1e-6 * a[(0, 0)].powi(3) {
         return None;
     }
     let beta = a.try_inverse()?.column(0).into_owned();
-    let mut rho = p.mass[i] * w0 * beta[0];
-    for Pair { j, xij, w, .. } in body_pairs(p, nl, k, i) {
-        let q = Vector3::new(1.0, -xij.x * inv_h, -xij.y * inv_h);
-        rho += p.mass[j] * w * beta.dot(&q);
-    }
+    let rho = beta.dot(&b);
     (rho.is_finite() && rho > 0.0).then_some(rho)
 }
 
