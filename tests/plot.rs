@@ -105,6 +105,7 @@ fn plot_writes_every_chart_for_the_quick_results() {
     assert!(!files.contains("modified_oka.png"), "{files:?}");
     assert!(stdout.contains("no Oka fit"), "{stdout}");
     assert!(stdout.contains("no modified-Oka chart"), "{stdout}");
+    assert!(stdout.contains("no one-sample-per-angle chart"), "{stdout}");
     assert_eq!(check_images(dir.path()), 5);
     assert!(stdout.contains("hexagon") && stdout.contains("2.952e-3 ± 3.413e-4"));
     assert!(stdout.contains("wrote 10 files:"), "{stdout}");
@@ -207,7 +208,25 @@ fn plot_draws_raw_series_oka_fits_and_the_modified_model() {
     ] {
         assert_has(&files, stem);
     }
-    assert_eq!(check_images(dir.path()), 18 + 4);
+    // 18 cells, 4 angle/fit charts, and per shape two single-sample-at-every-angle charts.
+    assert_eq!(check_images(dir.path()), 18 + 4 + 3 * 2);
+    for shape in ["octagon", "hexagon", "square"] {
+        assert_has(&files, &format!("sample_by_angle_{shape}_s0"));
+        assert_has(&files, &format!("sample_by_angle_{shape}_s1"));
+    }
+    assert!(
+        !files.contains("sample_by_angle_hexagon_s2.png"),
+        "{files:?}"
+    );
+    // Fig. 9: sample 1 of every angle of the hexagon on one axes, one legend entry each.
+    let svg = std::fs::read_to_string(dir.path().join("sample_by_angle_hexagon_s1.svg")).unwrap();
+    assert!(svg.contains("hexagon, sample 1"), "not named as one sample");
+    for angle in [15, 30, 45, 60, 75, 90] {
+        assert!(
+            svg.contains(&format!("\n{angle}°\n")),
+            "{angle}° curve missing"
+        );
+    }
     for shape in ["octagon", "hexagon", "square"] {
         assert!(
             stdout.contains(&format!("{shape}: Oka fit n1 = ")),
@@ -229,6 +248,7 @@ fn plot_draws_the_committed_raw_results() {
     assert!(check_images(dir.path()) >= 4, "{stdout}");
     let svg = std::fs::read_to_string(dir.path().join("mass_loss_c00_45deg_hexagon.svg")).unwrap();
     assert!(svg.contains("each sample (2)"), "raw series not drawn");
+    assert_has(&files, "sample_by_angle_hexagon_s0");
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! The five chart kinds. Masses are shown in g (grains) and mg (surface) per metre of
+//! The six chart kinds. Masses are shown in g (grains) and mg (surface) per metre of
 //! depth, since the engine is 2D and its masses are per metre; erosion is shown in mg of
 //! surface lost per g of grains (10⁻³ of the dimensionless erosion), so the slope of the
 //! mass-loss chart reads directly as erosion.
@@ -13,7 +13,7 @@ use crate::analysis::{series_label, Analysis, Series, HV_GPA};
 use crate::draw::{
     colour, de, error_bar, file_safe, save, top, with_notes, DrawResult, Figure, FONT,
 };
-use crate::{PlotError, PlotInput, Report};
+use crate::{PlotError, PlotInput, RawSeries, Report};
 
 /// Erosion (dimensionless) to mg per g.
 const MG_PER_G: f64 = 1e3;
@@ -65,6 +65,23 @@ fn dash_key(
     gap: i32,
 ) -> impl Fn((i32, i32)) -> DashedPathElement<std::vec::IntoIter<(i32, i32)>, i32> {
     move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 22, y)], dash, gap, style)
+}
+
+/// A sample's cumulative (grain g/m, loss mg/m), in impact order.
+fn sample_curve(r: &RawSeries) -> Vec<(f64, f64)> {
+    let mut impacts = r.impacts.clone();
+    impacts.sort_by_key(|m| m.impact);
+    let impacts: Vec<Impact> = impacts
+        .iter()
+        .map(|m| Impact {
+            grain_mass_kg: m.grain_mass_kg,
+            mass_loss_kg: m.mass_loss_kg,
+        })
+        .collect();
+    cumulative_series(&impacts)
+        .iter()
+        .map(|p| (p.grain_mass_kg * G_PER_KG, p.mass_loss_kg * MG_PER_KG))
+        .collect()
 }
 
 // ---------------------------------------------------------------- mass loss (Figs. 8, 10b)
@@ -213,21 +230,7 @@ pub fn mass_loss(
             .iter()
             .flatten()
             .filter(|r| r.cell as usize == i && !r.impacts.is_empty())
-            .map(|r| {
-                let mut impacts = r.impacts.clone();
-                impacts.sort_by_key(|m| m.impact);
-                let impacts: Vec<Impact> = impacts
-                    .iter()
-                    .map(|m| Impact {
-                        grain_mass_kg: m.grain_mass_kg,
-                        mass_loss_kg: m.mass_loss_kg,
-                    })
-                    .collect();
-                cumulative_series(&impacts)
-                    .iter()
-                    .map(|p| (p.grain_mass_kg * G_PER_KG, p.mass_loss_kg * MG_PER_KG))
-                    .collect()
-            })
+            .map(sample_curve)
             .collect();
         let mut notes = Vec::new();
         if input.raw.is_none() {
@@ -264,6 +267,135 @@ pub fn mass_loss(
             file_safe(&series_label(&c.shape, &c.swept))
         );
         report.files.extend(save(&fig, out, &stem)?);
+    }
+    Ok(())
+}
+
+// ----------------------------------------------- one sample at every angle (Fig. 9)
+
+struct SampleAngles {
+    label: String,
+    sample: u32,
+    /// (angle, cumulative (grain g/m, loss mg/m)), by angle.
+    curves: Vec<(f64, Vec<(f64, f64)>)>,
+    window: usize,
+    notes: Vec<String>,
+}
+
+impl Figure for SampleAngles {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let area = with_notes(root, &self.notes)?;
+        let all = || self.curves.iter().flat_map(|c| c.1.iter().copied());
+        let xmax = top(all().map(|p| p.0));
+        let ymax = top(all().map(|p| p.1));
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                format!(
+                    "Mass loss of one surface sample at each angle: {}, sample {}",
+                    self.label, self.sample
+                ),
+                (FONT, 22),
+            )
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(0.0..xmax, 0.0..ymax)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc("cumulative grain mass (g per m of depth)")
+            .y_desc("cumulative surface mass loss (mg per m of depth)")
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 17))
+            .draw()
+            .map_err(de)?;
+        for (i, (angle, pts)) in self.curves.iter().enumerate() {
+            let line = colour(i).stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), line))
+                .map_err(de)?
+                .label(format!("{angle}°"))
+                .legend(line_key(line));
+            if pts.len() >= self.window && self.window >= 2 {
+                let marks = colour(i).filled();
+                chart
+                    .draw_series(
+                        pts[pts.len() - self.window..]
+                            .iter()
+                            .map(|p| Circle::new(*p, 2, marks)),
+                    )
+                    .map_err(de)?;
+            }
+        }
+        legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
+    }
+}
+
+/// How many sample numbers get a one-sample-at-every-angle chart (the seed's Fig. 9 has 2).
+const SAMPLES_BY_ANGLE: usize = 2;
+
+/// Per series and for its two lowest sample numbers: that sample's mass-loss curve at every
+/// angle on one axes, the seed's Fig. 9 (a, b). Needs raw series at two angles or more.
+pub fn sample_by_angle(
+    input: &PlotInput,
+    out: &std::path::Path,
+    report: &mut Report,
+) -> Result<(), PlotError> {
+    let Some(raw) = &input.raw else {
+        report.notes.push(
+            "no per-impact series (grit run --raw or grit results --raw give them): \
+             no one-sample-per-angle chart"
+                .into(),
+        );
+        return Ok(());
+    };
+    let cells = &input.results.cells;
+    let mut labels: Vec<String> = Vec::new();
+    for c in cells {
+        let l = series_label(&c.shape, &c.swept);
+        if !labels.contains(&l) {
+            labels.push(l);
+        }
+    }
+    let window = input.results.slope_window;
+    for label in labels {
+        let in_series = |r: &&RawSeries| {
+            let c = &cells[r.cell as usize];
+            series_label(&c.shape, &c.swept) == label && !r.impacts.is_empty()
+        };
+        let numbers: std::collections::BTreeSet<u32> =
+            raw.iter().filter(in_series).map(|r| r.sample).collect();
+        let mut drawn = 0;
+        for &k in numbers.iter().take(SAMPLES_BY_ANGLE) {
+            let mut curves: Vec<(f64, Vec<(f64, f64)>)> = raw
+                .iter()
+                .filter(in_series)
+                .filter(|r| r.sample == k)
+                .map(|r| (cells[r.cell as usize].angle_deg, sample_curve(r)))
+                .collect();
+            if curves.len() < 2 {
+                continue;
+            }
+            curves.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let fig = SampleAngles {
+                label: label.clone(),
+                sample: k,
+                curves,
+                window,
+                notes: vec![format!(
+                    "Dots: the last {window} impacts, whose slope is the sample's erosion."
+                )],
+            };
+            let stem = format!("sample_by_angle_{}_s{k}", file_safe(&label));
+            report.files.extend(save(&fig, out, &stem)?);
+            drawn += 1;
+        }
+        if drawn == 0 {
+            report.notes.push(format!(
+                "{label}: no sample has per-impact series at two angles or more, \
+                 no one-sample-per-angle chart"
+            ));
+        }
     }
     Ok(())
 }

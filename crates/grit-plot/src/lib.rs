@@ -1,7 +1,8 @@
 //! grit-plot: charts of campaign results as PNG and SVG, after the seed paper's section 4
-//! figures: mass loss against grain mass (Figs. 8, 10b), erosion against impact angle with
-//! Oka's model (Figs. 11a, 12a), erosion normalised at 45° (Fig. 12b), the shape-modified
-//! Oka model (Fig. 14) and convergence with the number of samples (Fig. 10a).
+//! figures: mass loss against grain mass (Figs. 8, 10b), one sample at every angle
+//! (Fig. 9), erosion against impact angle with Oka's model (Figs. 11a, 12a), erosion
+//! normalised at 45° (Fig. 12b), the shape-modified Oka model (Fig. 14) and convergence
+//! with the number of samples (Fig. 10a).
 //!
 //! It reads the results JSON that `grit run` and `grit results` write (grit-erosion's
 //! `CampaignResults`, plus the optional `raw` per-impact series) and knows nothing of the
@@ -76,6 +77,7 @@ pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
     let analysis = analysis::Analysis::new(&input.results);
     let mut report = Report::default();
     charts::mass_loss(input, out, &mut report)?;
+    charts::sample_by_angle(input, out, &mut report)?;
     charts::erosion_vs_angle(&analysis, out, &mut report)?;
     charts::normalised(&analysis, out, &mut report)?;
     charts::modified_oka(&analysis, out, &mut report)?;
