@@ -3,8 +3,8 @@
 //! surface has settled.
 
 use grit_sph::{
-    contact::ContactModel, particles::KINEMATIC, ContactParams, InputError, Material, Motion,
-    Particles, Polygon, Settings, SimError, Timers, Vector, World,
+    cfl_matched_stiffness, contact::ContactModel, particles::KINEMATIC, ContactParams, InputError,
+    KernelKind, Material, Motion, Particles, Polygon, Settings, SimError, Timers, Vector, World,
 };
 use serde::{Deserialize, Serialize};
 
@@ -39,6 +39,41 @@ pub struct ImpactParams {
     /// The impact ends once the grain has left and the surface kinetic energy is below this
     /// fraction of the grain's initial kinetic energy.
     pub settle_fraction: f64,
+    /// Numerical choices; the defaults are the seed's (issue 5 sweeps them).
+    pub numerics: Numerics,
+}
+
+/// The numerical choices of an impact scene that issue 5's speed–accuracy and stability studies
+/// vary; the defaults are the seed's sections 2–3.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Numerics {
+    /// Kernel (seed: the quintic spline of eq. 4).
+    pub kernel: KernelKind,
+    /// Courant number of the time step.
+    pub cfl: f64,
+    /// Hourglass coefficient α of eq. 16.
+    pub hourglass: f64,
+    /// Contact detection (seed: extrapolated distance and normal, eqs. 21–23).
+    pub contact_model: ContactModel,
+    /// Repulsion and friction spring stiffness (eqs. 24–25) over the CFL-matched default.
+    pub contact_stiffness_scale: f64,
+    /// Whether the contact springs may shorten the time step (off only in the stability map).
+    pub contact_limits_dt: bool,
+}
+
+impl Default for Numerics {
+    fn default() -> Self {
+        let s = Settings::default();
+        Numerics {
+            kernel: s.kernel,
+            cfl: s.cfl,
+            hourglass: s.hourglass,
+            contact_model: ContactModel::Extrapolated,
+            contact_stiffness_scale: 1.0,
+            contact_limits_dt: s.contact_limits_dt,
+        }
+    }
 }
 
 impl Default for ImpactParams {
@@ -56,6 +91,7 @@ impl Default for ImpactParams {
             surface_width_dg: 4.0,
             surface_depth_dg: 1.5,
             settle_fraction: 0.02,
+            numerics: Numerics::default(),
         }
     }
 }
@@ -63,6 +99,9 @@ impl Default for ImpactParams {
 /// Layers of fixed particles at the bottom and the sides of the surface: at least the kernel
 /// support (3h = 3.9 Δx), so free particles never see a truncated kernel there.
 const FIXED_LAYERS: f64 = 4.0;
+/// Fewest particle layers a surface may have: fixed layers below, free layers between, and as
+/// many again for the impact to work in.
+pub const MIN_SURFACE_LAYERS: f64 = 3.0 * FIXED_LAYERS;
 /// Height of the grain's lowest point above the surface at the start, in Δx: just outside the
 /// contact range so no time is spent flying.
 const START_GAP_DX: f64 = 1.5;
@@ -128,18 +167,28 @@ impl ImpactParams {
             ));
         }
         let layers = self.surface_depth_dg * self.grain_diameter_m / self.spacing_m;
-        if layers < 3.0 * FIXED_LAYERS {
+        if layers < MIN_SURFACE_LAYERS {
             return Err(InputError::new(
                 "surface_depth_dg",
                 format!(
                     "gives {layers:.1} particle layers; at least {} are needed",
-                    3.0 * FIXED_LAYERS
+                    MIN_SURFACE_LAYERS
                 ),
             ));
         }
         self.material
             .validate()
             .map_err(|e| InputError::new(format!("material.{}", e.field), e.rule))?;
+        let k = self.numerics.contact_stiffness_scale;
+        if !(k.is_finite() && k > 0.0) {
+            return Err(InputError::new(
+                "numerics.contact_stiffness_scale",
+                format!("must be > 0, got {k}"),
+            ));
+        }
+        self.settings()
+            .validate()
+            .map_err(|e| InputError::new(format!("numerics.{}", e.field), e.rule))?;
         self.shape
             .validate("shape")
             .map_err(|e| InputError::new("shape", e.to_string()))?;
@@ -154,8 +203,13 @@ impl ImpactParams {
 
     /// Engine settings for this scene (seed sections 2–3 defaults at this spacing).
     pub fn settings(&self) -> Settings {
+        let n = &self.numerics;
         Settings {
             spacing_m: self.spacing_m,
+            kernel: n.kernel,
+            cfl: n.cfl,
+            hourglass: n.hourglass,
+            contact_limits_dt: n.contact_limits_dt,
             ..Settings::default()
         }
     }
@@ -306,6 +360,11 @@ pub fn run_impact(
     run_impact_observed(params, surface, grain, cancel, None)
 }
 
+/// Simulated time after which an impact is given up as never meeting its end criterion (s).
+pub fn max_impact_time(params: &ImpactParams) -> f64 {
+    MAX_TRANSITS * params.grain_diameter_m / params.velocity_m_s
+}
+
 /// The grain's body number in an impact's world (the surface is body 0).
 pub const GRAIN_BODY: usize = 1;
 
@@ -343,8 +402,12 @@ pub fn impact_world(
         g,
         s,
         ContactParams {
-            model: ContactModel::Extrapolated,
+            model: params.numerics.contact_model,
             friction: params.friction,
+            normal_stiffness_pa: Some(
+                params.numerics.contact_stiffness_scale
+                    * cfl_matched_stiffness(&params.material, world.settings().h_over_dx),
+            ),
             ..Default::default()
         },
     )?;
@@ -369,7 +432,7 @@ pub fn run_impact_observed(
     let particles = world.particles().len();
     let dg = params.grain_diameter_m;
     let half_width = 0.5 * params.surface_width_dg * dg;
-    let t_max = MAX_TRANSITS * dg / params.velocity_m_s;
+    let t_max = max_impact_time(params);
     let mut quiet = 0u32;
     let (mut detached_kg, mut detached_particles) = (0.0, 0u32);
     let mut settled = false;

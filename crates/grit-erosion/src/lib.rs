@@ -10,7 +10,9 @@ pub mod fits;
 pub mod impact;
 pub mod sample;
 pub mod shapes;
+pub mod stability;
 pub mod studies;
+pub mod sweep;
 
 pub use aggregate::{
     aggregate_campaign, aggregate_cell, AggregateError, CampaignResults, CellInput, CellResult,
@@ -20,6 +22,6 @@ pub use fits::{
     fit_modified_oka, fit_oka, FitError, ModifiedOkaModel, OkaModel, ShapeExponents,
     ShapeReference, AISI304_HV_GPA,
 };
-pub use impact::{ImpactError, ImpactOutcome, ImpactParams};
+pub use impact::{ImpactError, ImpactOutcome, ImpactParams, Numerics};
 pub use sample::{ImpactRecord, Sample, SampleError};
 pub use shapes::{Shape, ShapeError, ShapeInfo};

@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::kernel::Kernel;
+use crate::material::Material;
 use crate::math::{perp, Vector};
 
 /// How contact distance and normal are found.
@@ -48,6 +49,12 @@ impl Default for ContactParams {
             damping_ratio: 0.0,
         }
     }
+}
+
+/// The default repulsion stiffness k_r of eq. 24 (N/m²): the spring whose period on a particle of
+/// mass ρΔx² equals the material's CFL step, m/k = (h/c)², so k = ρc²/(h/Δx)².
+pub fn cfl_matched_stiffness(m: &Material, h_over_dx: f64) -> f64 {
+    m.density_kg_m3 * m.sound_speed().powi(2) / h_over_dx.powi(2)
 }
 
 /// A primary–secondary pair with its resolved stiffnesses.

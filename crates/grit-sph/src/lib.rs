@@ -22,7 +22,7 @@ pub mod vtk;
 pub mod world;
 
 pub use body::{Body, BodyKind, ExternalForce, Motion, Rigid};
-pub use contact::{ContactModel, ContactParams};
+pub use contact::{cfl_matched_stiffness, ContactModel, ContactParams};
 pub use geometry::Polygon;
 pub use kernel::{Kernel, KernelKind};
 pub use math::{Matrix, Vector};

@@ -6,7 +6,7 @@
 
 use super::{CaseReport, Chart, Row, Series};
 use crate::body::Motion;
-use crate::contact::{ContactModel, ContactParams};
+use crate::contact::{cfl_matched_stiffness, ContactModel, ContactParams};
 use crate::error::SimError;
 use crate::geometry::Polygon;
 use crate::material::Material;
@@ -128,15 +128,30 @@ pub struct Snapshot {
 /// each of LOADS; returns one snapshot per load. `shepard_interval` is the density filter's
 /// (eq. 12) period in steps, 0 for none (this case's choice, see DENSITY_FILTER).
 pub fn simulate(n_radius: usize, shepard_interval: u32) -> Result<Vec<Snapshot>, SimError> {
+    simulate_with(
+        n_radius,
+        Settings {
+            shepard_interval,
+            ..Settings::default()
+        },
+    )
+}
+
+/// `simulate` with other engine settings (kernel, Courant number, …); their spacing is
+/// replaced by the radius over `n_radius`. For the speed–accuracy sweep of issue 5.
+pub fn simulate_with(n_radius: usize, settings: Settings) -> Result<Vec<Snapshot>, SimError> {
     let dx = RADIUS / n_radius as f64;
     let mat = Material::elastic_aluminium();
     let bulk = mat.bulk_modulus();
     let mut w = World::new(Settings {
         spacing_m: dx,
-        shepard_interval,
-        ..Settings::default()
+        ..settings
     })
-    .expect("valid settings");
+    .map_err(|e| SimError {
+        step: 0,
+        time_s: 0.0,
+        what: e.to_string(),
+    })?;
     let flat = Polygon::rectangle(-RADIUS, -3.0 * dx, RADIUS, 0.0);
     let flat_b = w
         .add_rigid("flat", &flat, 7800.0, Vector::zeros(), 0.0, Motion::Fixed)
@@ -160,8 +175,7 @@ pub fn simulate(n_radius: usize, shepard_interval: u32) -> Result<Vec<Snapshot>,
         |x| x.y > top,
     )
     .expect("deformable");
-    let h_over_dx = w.settings().h_over_dx;
-    let k_default = mat.density_kg_m3 * mat.sound_speed().powi(2) / h_over_dx.powi(2);
+    let k_default = cfl_matched_stiffness(&mat, w.settings().h_over_dx);
     w.add_contact(
         flat_b,
         cyl,
@@ -232,6 +246,15 @@ pub fn simulate(n_radius: usize, shepard_interval: u32) -> Result<Vec<Snapshot>,
         });
     }
     Ok(out)
+}
+
+/// The largest relative error of p0 over the loads of `snapshots` (the verification's figure).
+pub fn max_peak_error(snapshots: &[Snapshot]) -> Option<f64> {
+    let e_star = contact_modulus(&Material::elastic_aluminium());
+    snapshots
+        .iter()
+        .map(|s| peak_error(s, e_star))
+        .reduce(f64::max)
 }
 
 /// Relative error of the simulated peak pressure against eq. 31 at the simulated load.
