@@ -9,6 +9,7 @@ use std::time::Duration;
 
 use clap::{Args, Subcommand};
 use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::stability::StabilityGrid;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use uuid::Uuid;
 
@@ -299,6 +300,88 @@ enum BenchWhat {
         /// Print the figures as JSON.
         #[arg(long)]
         json: bool,
+    },
+    /// The speed–accuracy sweep: erosion of the hexagon (samples × impacts) and the Hertz p0
+    /// error at several resolutions and numerical variants, against wall time per impact.
+    /// Writes OUT/sweep.{csv,json,png,svg} and names the cheapest setting within the finest's
+    /// error bars.
+    Sweep {
+        /// Impact angle (degrees).
+        #[arg(long, default_value_t = 45.0)]
+        angle: f64,
+        /// Resolutions, particles per grain diameter, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![8.0, 12.0, 16.0, 24.0, 32.0])]
+        ppd: Vec<f64>,
+        /// Numerical variants (seed, wendland_c2, cfl=X), comma-separated; the first is the
+        /// reference.
+        #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
+        variants: Vec<String>,
+        /// Resolutions of the variants after the first (default: all of --ppd).
+        #[arg(long, value_delimiter = ',')]
+        variant_ppd: Vec<f64>,
+        /// Samples per point.
+        #[arg(long, default_value_t = 5)]
+        samples: u32,
+        /// Impacts per sample.
+        #[arg(long, default_value_t = 30)]
+        impacts: u32,
+        /// Seed of sample 0; sample k uses seed + k.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Width of the band of aim points (Dg); the reduced campaign's 0.5 by default.
+        #[arg(long, default_value_t = 0.5)]
+        range_dg: f64,
+        /// Surface width (Dg); the reduced campaign's 2.5 (checked by its domain study).
+        #[arg(long, default_value_t = 2.5)]
+        width_dg: f64,
+        /// Surface depth (Dg); the reduced campaign's 1.25.
+        #[arg(long, default_value_t = 1.25)]
+        depth_dg: f64,
+        /// Output folder.
+        #[arg(long, default_value = "out/sweep")]
+        out: PathBuf,
+        /// Keep the points already in OUT/sweep.json and run only the missing ones.
+        #[arg(long)]
+        resume: bool,
+        /// Threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// The stability map: one impact with the Courant number swept against the hourglass
+    /// coefficient, and the contact stiffness against the time step for both contact models;
+    /// each point stable or with the engine's diagnostic. Writes OUT/stability.{csv,json,png,svg}.
+    Stability {
+        /// Impact angle (degrees).
+        #[arg(long, default_value_t = 45.0)]
+        angle: f64,
+        /// Particle spacing Δx (m): 1.5625e-5 is 16 particles per Dg.
+        #[arg(long, default_value_t = 1.5625e-5)]
+        spacing_m: f64,
+        /// Impacts the surface takes (with the default numerics) before the mapped one.
+        #[arg(long, default_value_t = 0)]
+        after: u32,
+        /// Seed of the sample the grain comes from.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Courant numbers, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().cfl)]
+        cfl: Vec<f64>,
+        /// Hourglass coefficients α, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().hourglass)]
+        hourglass: Vec<f64>,
+        /// Contact stiffness over the default k, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().stiffness_scale)]
+        stiffness: Vec<f64>,
+        /// A point is stopped as collapsed after this many times the steps the longest impact
+        /// takes at its first step's dt.
+        #[arg(long, default_value_t = 3.0)]
+        budget: f64,
+        /// Output folder.
+        #[arg(long, default_value = "out/stability")]
+        out: PathBuf,
+        /// Threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
     },
 }
 
@@ -754,6 +837,53 @@ fn bench_impact(
     Ok(ExitCode::SUCCESS)
 }
 
+/// A rayon pool of `threads` threads (all cores when `None`).
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
+    if threads == Some(0) {
+        return Err(CliError("--threads: must be at least 1".into()));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| CliError(format!("thread pool: {e}")))
+}
+
+fn bench_stability(args: crate::studies::StabilityArgs, threads: Option<usize>) -> CliResult {
+    let points = pool(threads)?
+        .install(|| crate::studies::stability(&args))
+        .map_err(CliError)?;
+    print!("{}", crate::studies::stability_table(&points));
+    say!(
+        "wrote {0}/stability.csv, .json, .png and .svg",
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn bench_sweep(args: crate::studies::SweepArgs, threads: Option<usize>) -> CliResult {
+    let rows = pool(threads)?
+        .install(|| crate::studies::sweep(&args))
+        .map_err(CliError)?;
+    say!("summary of {}:", args.out.join("sweep.json").display());
+    for r in &rows {
+        say!("{}", crate::studies::sweep_line(r));
+    }
+    match grit_erosion::sweep::cheapest_within(&rows) {
+        Some(b) => say!(
+            "cheapest within the finest's ±1 std: {} at {} per Dg, {:.3} s per impact",
+            b.variant,
+            b.particles_per_dg,
+            b.wall_per_impact_s
+        ),
+        None => say!("no erosion at the finest resolution: no setting can be judged against it"),
+    }
+    say!(
+        "wrote {0}/sweep.csv, .json, .png and .svg",
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 async fn bench(a: BenchArgs) -> CliResult {
     let (clients, seconds, dir, json) = match a.what {
         BenchWhat::Farm {
@@ -762,6 +892,74 @@ async fn bench(a: BenchArgs) -> CliResult {
             dir,
             json,
         } => (clients, seconds, dir, json),
+        BenchWhat::Sweep {
+            angle,
+            ppd,
+            variants,
+            variant_ppd,
+            samples,
+            impacts,
+            seed,
+            range_dg,
+            width_dg,
+            depth_dg,
+            out,
+            resume,
+            threads,
+        } => {
+            let variants = variants
+                .iter()
+                .map(|v| grit_erosion::sweep::Variant::parse(v))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(CliError)?;
+            let args = crate::studies::SweepArgs {
+                params: grit_erosion::ImpactParams {
+                    distribution_range_dg: range_dg,
+                    surface_width_dg: width_dg,
+                    surface_depth_dg: depth_dg,
+                    ..crate::studies::scene(angle, 8e-6)
+                },
+                ppd,
+                variants,
+                variant_ppd,
+                samples,
+                impacts,
+                seed,
+                out,
+                resume,
+            };
+            return tokio::task::spawn_blocking(move || bench_sweep(args, threads))
+                .await
+                .map_err(|e| CliError(format!("benchmark thread: {e}")))?;
+        }
+        BenchWhat::Stability {
+            angle,
+            spacing_m,
+            after,
+            seed,
+            cfl,
+            hourglass,
+            stiffness,
+            budget,
+            out,
+            threads,
+        } => {
+            let args = crate::studies::StabilityArgs {
+                params: crate::studies::scene(angle, spacing_m),
+                seed,
+                after,
+                grid: StabilityGrid {
+                    cfl,
+                    hourglass,
+                    stiffness_scale: stiffness,
+                },
+                budget_factor: budget,
+                out,
+            };
+            return tokio::task::spawn_blocking(move || bench_stability(args, threads))
+                .await
+                .map_err(|e| CliError(format!("benchmark thread: {e}")))?;
+        }
         BenchWhat::Impact {
             angle,
             spacing_m,

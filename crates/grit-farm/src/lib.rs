@@ -13,6 +13,7 @@ pub mod db;
 pub mod embedded;
 pub mod error;
 pub mod server;
+pub mod studies;
 pub mod worker;
 
 pub use client::{Client, ClientError};

@@ -48,6 +48,16 @@ pub trait Figure {
 
 /// Draws `fig` as `out/stem.png` and `out/stem.svg`; returns both paths.
 pub fn save(fig: &impl Figure, out: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
+    save_sized(fig, out, stem, SIZE)
+}
+
+/// `save` at `size` pixels instead of the common chart size.
+pub fn save_sized(
+    fig: &impl Figure,
+    out: &Path,
+    stem: &str,
+    size: (u32, u32),
+) -> Result<Vec<PathBuf>, PlotError> {
     let png = out.join(format!("{stem}.png"));
     let svg = out.join(format!("{stem}.svg"));
     let failed = |path: &Path| {
@@ -55,12 +65,12 @@ pub fn save(fig: &impl Figure, out: &Path, stem: &str) -> Result<Vec<PathBuf>, P
         move |message| PlotError::Draw { path, message }
     };
     {
-        let root = BitMapBackend::new(&png, SIZE).into_drawing_area();
+        let root = BitMapBackend::new(&png, size).into_drawing_area();
         fig.draw(&root).map_err(failed(&png))?;
         root.present().map_err(de).map_err(failed(&png))?;
     }
     {
-        let root = SVGBackend::new(&svg, SIZE).into_drawing_area();
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
         fig.draw(&root).map_err(failed(&svg))?;
         root.present().map_err(de).map_err(failed(&svg))?;
     }
@@ -78,7 +88,8 @@ pub fn with_notes<DB: DrawingBackend>(
         return Ok(root.clone());
     }
     let line = 19;
-    let (plot, strip) = root.split_vertically(SIZE.1 as i32 - line * notes.len() as i32 - 10);
+    let height = root.dim_in_pixel().1 as i32;
+    let (plot, strip) = root.split_vertically(height - line * notes.len() as i32 - 10);
     let grey = BLACK.mix(0.8);
     let style = TextStyle::from((FONT, 14).into_font()).color(&grey);
     for (i, n) in notes.iter().enumerate() {

@@ -15,7 +15,9 @@ mod charts;
 mod draw;
 mod fonts;
 mod input;
+mod stability;
 mod surface;
+mod sweep;
 
 use std::path::{Path, PathBuf};
 
@@ -24,7 +26,9 @@ use grit_erosion::CampaignResults;
 pub use draw::colour;
 pub use fonts::register_fonts;
 pub use input::{load, merge, parse, PlotInput, RawImpact, RawSeries};
+pub use stability::stability_chart;
 pub use surface::{surface_png, viridis, SurfaceField, SurfacePicture};
+pub use sweep::sweep_chart;
 
 /// Why charts could not be made: unreadable or invalid input, or an unwritable output.
 #[derive(Debug, thiserror::Error)]

@@ -1,0 +1,185 @@
+//! `grit bench stability` and `grit bench sweep` at CI size: they run, mark what fails, write
+//! their CSV, JSON and charts, resume without redoing points, and refuse bad input clearly.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use grit_erosion::stability::{Failure, Panel, StabilityPoint, Verdict};
+use grit_erosion::sweep::SweepRow;
+
+fn grit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_grit"))
+        .args(args)
+        .output()
+        .expect("run grit")
+}
+
+fn ok(out: &Output) -> String {
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "stdout: {stdout}\nstderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+fn png_ok(path: &Path) {
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8();
+    let colours: std::collections::BTreeSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 3, "{} is blank", path.display());
+}
+
+/// 8 particles per Dg (31.25 µm): the coarsest scene the validation accepts, seconds a point.
+const COARSE: &str = "3.125e-5";
+
+#[test]
+fn stability_map_marks_the_spring_limit_and_writes_its_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let stdout = ok(&grit(&[
+        "bench",
+        "stability",
+        "--spacing-m",
+        COARSE,
+        "--cfl",
+        "0.3,2.0",
+        "--hourglass",
+        "0.1",
+        "--stiffness",
+        "1,256",
+        "--out",
+        out,
+        "--threads",
+        "2",
+    ]));
+    assert!(
+        stdout.contains("stiffness × step, penetration contact"),
+        "{stdout}"
+    );
+    let points: Vec<StabilityPoint> =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("stability.json")).unwrap())
+            .unwrap();
+    assert_eq!(points.len(), 2 + 2 * 4);
+    let at = |panel: Panel, cfl: f64, k: f64| {
+        points
+            .iter()
+            .find(|p| p.panel == panel && p.cfl == cfl && p.stiffness_scale == k)
+            .unwrap()
+    };
+    for panel in [Panel::StiffnessStep, Panel::StiffnessStepPenetration] {
+        // The seed's numerics: the CFL-matched spring at Courant number 0.3 is stable.
+        let seed = at(panel, 0.3, 1.0);
+        assert_eq!(seed.verdict, Verdict::Stable, "{seed:?}");
+        assert!(seed.mass_loss_kg.is_some() && seed.rebound_ratio.is_some());
+        // 256 times stiffer with twice the material step: far beyond the spring's 2√(m/k).
+        let wild = at(panel, 2.0, 256.0);
+        assert_eq!(wild.verdict, Verdict::Unstable, "{wild:?}");
+        assert!(wild.diagnostic.as_deref().unwrap_or("").contains("step"));
+        assert_ne!(wild.failure, None);
+        assert!(wild.steps < 1000, "{wild:?}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("stability.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + points.len());
+    assert!(csv.starts_with("panel,contact_model,cfl,hourglass,stiffness_scale"));
+    png_ok(&dir.path().join("stability.png"));
+    let svg = std::fs::read_to_string(dir.path().join("stability.svg")).unwrap();
+    assert!(svg.contains("penetration contact") && svg.contains(Failure::PassedThrough.label()));
+}
+
+#[test]
+fn sweep_runs_two_variants_resumes_and_charts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let common = [
+        "bench",
+        "sweep",
+        "--samples",
+        "2",
+        "--impacts",
+        "21",
+        "--variants",
+        "seed,cfl=0.5",
+        "--out",
+        out,
+        "--threads",
+        "2",
+    ];
+    let first = ok(&grit(&[&common[..], &["--ppd", "8"]].concat()));
+    assert!(first.contains("CFL 0.5"), "{first}");
+    // Resuming with one resolution more runs only the missing points.
+    let second = ok(&grit(
+        &[&common[..], &["--ppd", "8,9", "--resume"]].concat(),
+    ));
+    let rows: Vec<SweepRow> =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
+            .unwrap();
+    assert_eq!(rows.len(), 4, "{second}");
+    let seed8: Vec<&SweepRow> = rows.iter().filter(|r| r.particles_per_dg == 8.0).collect();
+    assert_eq!(seed8.len(), 2);
+    for r in &rows {
+        assert_eq!((r.samples, r.impacts), (2, 21));
+        assert!(r.wall_per_impact_s > 0.0 && r.steps_per_impact > 0.0);
+        assert!(
+            r.erosion_mean.is_some(),
+            "every sample has 21 impacts: {r:?}"
+        );
+        // 1.25 Dg is 10–11 layers at 8–9 per Dg: deepened to the 12 the scene needs.
+        assert!(r.surface_depth_dg > 1.25, "{r:?}");
+        assert!(
+            (r.surface_depth_dg * r.particles_per_dg - 12.0).abs() < 1e-6,
+            "{r:?}"
+        );
+        let e = r.hertz_p0_error.expect("Hertz runs at 8–9 per radius");
+        assert!(e > 0.0 && e < 1.0, "{r:?}");
+    }
+    // A larger Courant number takes fewer steps for the same impacts.
+    let steps = |v: &str| {
+        rows.iter()
+            .find(|r| r.variant == v && r.particles_per_dg == 8.0)
+            .unwrap()
+            .steps_per_impact
+    };
+    assert!(steps("CFL 0.5") < steps("seed (quintic, CFL 0.3)"));
+    let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5);
+    png_ok(&dir.path().join("sweep.png"));
+}
+
+#[test]
+fn studies_refuse_bad_input_naming_the_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["bench", "stability", "--cfl", "0.3,3", "--out", out],
+            "--cfl: 3",
+        ),
+        (
+            &["bench", "stability", "--stiffness", "0", "--out", out],
+            "--stiffness: 0",
+        ),
+        (
+            &["bench", "stability", "--spacing-m", "1e-4", "--out", out],
+            "spacing_m",
+        ),
+        (
+            &["bench", "sweep", "--variants", "cubic", "--out", out],
+            "unknown variant `cubic`",
+        ),
+        (
+            &["bench", "sweep", "--impacts", "5", "--out", out],
+            "--impacts: at least 21",
+        ),
+        (&["bench", "sweep", "--ppd", "4", "--out", out], "--ppd"),
+    ];
+    for (args, expected) in cases {
+        let o = grit(args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
