@@ -122,6 +122,7 @@ fn sweep_runs_two_variants_resumes_and_charts() {
     for r in &rows {
         assert_eq!((r.samples, r.impacts), (2, 21));
         assert!(r.wall_per_impact_s > 0.0 && r.steps_per_impact > 0.0);
+        assert!(r.cpu_per_impact_s.is_some_and(|c| c > 0.0), "{r:?}");
         assert!(
             r.erosion_mean.is_some(),
             "every sample has 21 impacts: {r:?}"

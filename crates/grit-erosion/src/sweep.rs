@@ -95,6 +95,10 @@ pub struct SweepRow {
     pub steps_per_impact: f64,
     /// Wall time of all samples over all impacts (s), on `threads` threads.
     pub wall_per_impact_s: f64,
+    /// Process CPU time of all samples over all impacts (s): less skewed by other work on the
+    /// machine than the wall time (absent in files from before it was recorded).
+    #[serde(default)]
+    pub cpu_per_impact_s: Option<f64>,
     /// Threads the samples ran on.
     pub threads: usize,
     /// Largest relative error of the Hertz p0 (eq. 31) over 10–50 MN/m, at `hertz_per_radius`.
@@ -128,6 +132,7 @@ pub fn run_resolution(
     };
     params.validate()?;
     let t0 = Instant::now();
+    let cpu0 = cpu_time::ProcessTime::try_now().ok();
     let runs: Vec<Result<Sample, SampleError>> = (0..samples)
         .into_par_iter()
         .map(|k| {
@@ -141,6 +146,9 @@ pub fn run_resolution(
         })
         .collect();
     let wall = t0.elapsed().as_secs_f64();
+    let cpu = cpu0
+        .and_then(|c| c.try_elapsed().ok())
+        .map(|d| d.as_secs_f64());
     let runs: Vec<Sample> = runs.into_iter().collect::<Result<_, _>>()?;
     let cell = CellInput {
         angle_deg: params.angle_deg,
@@ -198,11 +206,49 @@ pub fn run_resolution(
         particles,
         steps_per_impact: steps as f64 / n_impacts,
         wall_per_impact_s: wall / n_impacts,
+        cpu_per_impact_s: cpu.map(|c| c / n_impacts),
         threads: rayon::current_num_threads(),
         hertz_p0_error,
         hertz_per_radius,
         hertz_failure,
     })
+}
+
+/// What the rows' cost is measured in: process CPU seconds per impact when every row has them
+/// (a loaded machine skews them less), else wall seconds per impact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cost {
+    /// `cpu_per_impact_s`.
+    Cpu,
+    /// `wall_per_impact_s`.
+    Wall,
+}
+
+impl Cost {
+    /// The measure `rows` can all be compared by.
+    pub fn of(rows: &[SweepRow]) -> Cost {
+        if rows.iter().all(|r| r.cpu_per_impact_s.is_some()) {
+            Cost::Cpu
+        } else {
+            Cost::Wall
+        }
+    }
+
+    /// The row's cost in this measure (s per impact).
+    pub fn get(self, r: &SweepRow) -> f64 {
+        match self {
+            Cost::Cpu => r.cpu_per_impact_s.unwrap_or(f64::NAN),
+            Cost::Wall => r.wall_per_impact_s,
+        }
+    }
+
+    /// Axis label.
+    pub fn label(self) -> &'static str {
+        match self {
+            Cost::Cpu => "CPU time per impact (s, all threads)",
+            Cost::Wall => "wall time per impact (s)",
+        }
+    }
 }
 
 /// The cheapest row whose erosion lies within ±1 standard deviation of the finest row of the
@@ -218,9 +264,10 @@ pub fn cheapest_within(rows: &[SweepRow]) -> Option<&SweepRow> {
     if m <= 0.0 {
         return None;
     }
+    let cost = Cost::of(rows);
     rows.iter()
         .filter(|r| r.erosion_mean.is_some_and(|e| (e - m).abs() <= s))
-        .min_by(|a, b| a.wall_per_impact_s.total_cmp(&b.wall_per_impact_s))
+        .min_by(|a, b| cost.get(a).total_cmp(&cost.get(b)))
 }
 
 #[cfg(test)]
@@ -253,6 +300,7 @@ mod tests {
             particles: 0,
             steps_per_impact: 0.0,
             wall_per_impact_s: wall,
+            cpu_per_impact_s: Some(2.0 * wall),
             threads: 2,
             hertz_p0_error: None,
             hertz_per_radius: ppd as usize,
@@ -275,6 +323,17 @@ mod tests {
             ("Wendland C2", 16.0)
         );
         assert!(cheapest_within(&[]).is_none());
+        // Judged by CPU time when every row has it: here the 8 per Dg row is CPU-cheapest.
+        let mut cpu = rows.clone();
+        for r in &mut cpu {
+            r.cpu_per_impact_s = Some(if r.particles_per_dg == 8.0 { 0.01 } else { 5.0 });
+        }
+        cpu[0].erosion_mean = Some(2.1e-3);
+        assert_eq!(Cost::of(&cpu), Cost::Cpu);
+        assert_eq!(cheapest_within(&cpu).unwrap().particles_per_dg, 8.0);
+        let mut mixed = cpu.clone();
+        mixed[1].cpu_per_impact_s = None;
+        assert_eq!(Cost::of(&mixed), Cost::Wall);
         let none = vec![
             row("seed", 8.0, Some(0.0), 0.0, 0.1),
             row("seed", 32.0, Some(0.0), 0.0, 9.0),

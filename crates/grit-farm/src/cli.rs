@@ -869,12 +869,16 @@ fn bench_sweep(args: crate::studies::SweepArgs, threads: Option<usize>) -> CliRe
         say!("{}", crate::studies::sweep_line(r));
     }
     match grit_erosion::sweep::cheapest_within(&rows) {
-        Some(b) => say!(
-            "cheapest within the finest's ±1 std: {} at {} per Dg, {:.3} s per impact",
-            b.variant,
-            b.particles_per_dg,
-            b.wall_per_impact_s
-        ),
+        Some(b) => {
+            let cost = grit_erosion::sweep::Cost::of(&rows);
+            say!(
+                "cheapest within the finest's ±1 std: {} at {} per Dg, {:.3} s per impact ({})",
+                b.variant,
+                b.particles_per_dg,
+                cost.get(b),
+                cost.label()
+            )
+        }
         None => say!("no erosion at the finest resolution: no setting can be judged against it"),
     }
     say!(

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use grit_erosion::aggregate::SLOPE_WINDOW;
 use grit_erosion::stability::{self, Panel, StabilityGrid, StabilityPoint, Verdict};
-use grit_erosion::sweep::{cheapest_within, SweepRow, Variant};
+use grit_erosion::sweep::{cheapest_within, Cost, SweepRow, Variant};
 use grit_erosion::{ImpactParams, Shape};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -293,8 +293,11 @@ pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
     )];
     if let Some(best) = cheapest_within(&rows) {
         notes.push(format!(
-            "Cheapest within the finest's bars: {} at {} per Dg ({:.3} s per impact).",
-            best.variant, best.particles_per_dg, best.wall_per_impact_s
+            "Cheapest within the finest's bars: {} at {} per Dg ({:.3} s per impact, {}).",
+            best.variant,
+            best.particles_per_dg,
+            Cost::of(&rows).get(best),
+            Cost::of(&rows).label()
         ));
     }
     grit_plot::sweep_chart(&rows, &a.out, "sweep", &notes).map_err(|e| e.to_string())?;
@@ -305,13 +308,14 @@ pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
 pub fn sweep_line(r: &SweepRow) -> String {
     let mg = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{:.3}", x * 1e3));
     format!(
-        "{:<24} {:>5} per Dg (depth {:.2} Dg)  {:>6} particles  {:>7.0} steps  {:>8.3} s/impact  erosion {} ± {} (se {}) mg/g, {}/{} samples with loss  Hertz p0 error {}",
+        "{:<24} {:>5} per Dg (depth {:.2} Dg)  {:>6} particles  {:>7.0} steps  {:>8.3} s/impact ({} CPU-s)  erosion {} ± {} (se {}) mg/g, {}/{} samples with loss  Hertz p0 error {}",
         r.variant,
         r.particles_per_dg,
         r.surface_depth_dg,
         r.particles,
         r.steps_per_impact,
         r.wall_per_impact_s,
+        r.cpu_per_impact_s.map_or("–".to_string(), |c| format!("{c:.3}")),
         mg(r.erosion_mean),
         mg(r.erosion_std),
         mg(r.erosion_sem),

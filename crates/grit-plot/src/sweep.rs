@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use grit_erosion::sweep::SweepRow;
+use grit_erosion::sweep::{Cost, SweepRow};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -18,6 +18,7 @@ const MG_PER_G: f64 = 1e3;
 
 struct Sweep<'a> {
     rows: &'a [SweepRow],
+    cost: Cost,
     variants: Vec<String>,
     notes: Vec<String>,
 }
@@ -37,7 +38,7 @@ fn log_range(v: impl Iterator<Item = f64>) -> (f64, f64) {
 impl Sweep<'_> {
     fn erosion<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
         let rows = self.rows;
-        let (x0, x1) = log_range(rows.iter().map(|r| r.wall_per_impact_s));
+        let (x0, x1) = log_range(rows.iter().map(|r| self.cost.get(r)));
         let bars = || {
             rows.iter().filter_map(|r| {
                 let e = r.erosion_mean?;
@@ -56,7 +57,7 @@ impl Sweep<'_> {
             .map_err(de)?;
         chart
             .configure_mesh()
-            .x_desc("wall time per impact (s)")
+            .x_desc(self.cost.label())
             .y_desc("erosion (mg per g of grains), bars ±1 std over samples")
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
@@ -86,7 +87,7 @@ impl Sweep<'_> {
             let mine: Vec<&SweepRow> = rows.iter().filter(|r| &r.variant == v).collect();
             for r in &mine {
                 if let (Some(e), Some(s)) = (r.erosion_mean, r.erosion_std) {
-                    let x = r.wall_per_impact_s;
+                    let x = self.cost.get(r);
                     chart
                         .draw_series(error_bar(
                             x,
@@ -102,7 +103,7 @@ impl Sweep<'_> {
                 .iter()
                 .filter_map(|r| {
                     Some((
-                        r.wall_per_impact_s,
+                        self.cost.get(r),
                         r.erosion_mean? * MG_PER_G,
                         r.particles_per_dg,
                     ))
@@ -141,7 +142,7 @@ impl Sweep<'_> {
 
     fn hertz<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
         let rows = self.rows;
-        let (x0, x1) = log_range(rows.iter().map(|r| r.wall_per_impact_s));
+        let (x0, x1) = log_range(rows.iter().map(|r| self.cost.get(r)));
         let errs = || {
             rows.iter()
                 .filter_map(|r| r.hertz_p0_error.map(|e| e * 100.0))
@@ -156,7 +157,7 @@ impl Sweep<'_> {
             .map_err(de)?;
         chart
             .configure_mesh()
-            .x_desc("wall time per impact of the erosion scene (s)")
+            .x_desc(format!("{} of the erosion scene", self.cost.label()))
             .y_desc("largest p0 error over 10–50 MN/m (%)")
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
@@ -180,7 +181,7 @@ impl Sweep<'_> {
                 .filter(|r| &r.variant == v)
                 .filter_map(|r| {
                     Some((
-                        r.wall_per_impact_s,
+                        self.cost.get(r),
                         r.hertz_p0_error? * 100.0,
                         r.hertz_per_radius,
                     ))
@@ -244,7 +245,7 @@ pub fn sweep_chart(
     }
     let mut all = vec![
         "Labels: particles per grain diameter (left) and per Hertz cylinder radius (right). \
-         Wall time is of all samples side by side over the impacts, on the run's threads."
+         Cost: all samples side by side over the impacts, on the run's threads."
             .to_string(),
     ];
     all.extend(notes.iter().cloned());
@@ -255,6 +256,7 @@ pub fn sweep_chart(
     save_sized(
         &Sweep {
             rows,
+            cost: Cost::of(rows),
             variants,
             notes: all,
         },
