@@ -23,6 +23,12 @@ struct Sweep<'a> {
     notes: Vec<String>,
 }
 
+/// A log-axis tick as a short number: two significant digits, no float noise.
+fn short(v: &f64) -> String {
+    let digits = (1.0 - v.abs().log10().floor()).max(0.0) as usize;
+    format!("{v:.digits$}")
+}
+
 /// Log axis bounds around `v`, a little beyond the extremes.
 fn log_range(v: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = v
@@ -58,6 +64,8 @@ impl Sweep<'_> {
         chart
             .configure_mesh()
             .x_desc(self.cost.label())
+            .x_label_formatter(&short)
+            .light_line_style(BLACK.mix(0.04))
             .y_desc("erosion (mg per g of grains), bars ±1 std over samples")
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
@@ -158,6 +166,9 @@ impl Sweep<'_> {
         chart
             .configure_mesh()
             .x_desc(format!("{} of the erosion scene", self.cost.label()))
+            .x_label_formatter(&short)
+            .y_label_formatter(&short)
+            .light_line_style(BLACK.mix(0.04))
             .y_desc("largest p0 error over 10–50 MN/m (%)")
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
