@@ -281,6 +281,9 @@ pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
         write_json(&a.out, "sweep", &rows)?;
     }
     pb.finish_and_clear();
+    // Also when --resume found nothing left to run: the files then match the rows.
+    write_csv(&a.out, "sweep", &rows)?;
+    write_json(&a.out, "sweep", &rows)?;
     let mut notes = vec![format!(
         "Scene: {} at {}°, {} m/s, AISI 304; {} samples × {} impacts per point, seeds {}–{}; erosion = last-{SLOPE_WINDOW} slope.",
         a.params.shape.name(),
