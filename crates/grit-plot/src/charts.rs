@@ -37,7 +37,7 @@ fn bottom(values: impl Iterator<Item = f64>) -> f64 {
     1.1 * m
 }
 
-fn legend_box<'a, DB: DrawingBackend + 'a, X, Y>(
+pub(crate) fn legend_box<'a, DB: DrawingBackend + 'a, X, Y>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     pos: SeriesLabelPosition,
 ) -> DrawResult

@@ -8,6 +8,7 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
+use crate::charts::legend_box;
 use crate::draw::{colour, de, error_bar, save_sized, with_notes, DrawResult, Figure, FONT};
 use crate::{register_fonts, PlotError};
 
@@ -21,6 +22,27 @@ struct Sweep<'a> {
     cost: Cost,
     variants: Vec<String>,
     notes: Vec<String>,
+}
+
+/// Dots of colour `c` at (x, y), each labelled with its resolution.
+fn labelled_dots<'a, DB: DrawingBackend + 'a, X, Y, L: std::fmt::Display>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    pts: &[(f64, f64, L)],
+    c: RGBColor,
+) -> DrawResult
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+{
+    let text = TextStyle::from((FONT, 14).into_font()).color(&c);
+    chart
+        .draw_series(pts.iter().map(|p| {
+            EmptyElement::at((p.0, p.1))
+                + Circle::new((0, 0), 5, c.filled())
+                + Text::new(format!("{}", p.2), (7, -18), text.clone())
+        }))
+        .map_err(de)?;
+    Ok(())
 }
 
 /// A log-axis tick as a short number: two significant digits, no float noise.
@@ -129,23 +151,9 @@ impl Sweep<'_> {
                         + PathElement::new(vec![(0, 0), (22, 0)], c.stroke_width(2))
                         + Circle::new((11, 0), 4, c.filled())
                 });
-            let text = TextStyle::from((FONT, 14).into_font()).color(&c);
-            chart
-                .draw_series(pts.iter().map(|p| {
-                    EmptyElement::at((p.0, p.1))
-                        + Circle::new((0, 0), 5, c.filled())
-                        + Text::new(format!("{}", p.2), (7, -18), text.clone())
-                }))
-                .map_err(de)?;
+            labelled_dots(&mut chart, &pts, c)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(de)
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 
     fn hertz<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
@@ -208,23 +216,9 @@ impl Sweep<'_> {
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(2))
                 });
-            let text = TextStyle::from((FONT, 14).into_font()).color(&c);
-            chart
-                .draw_series(pts.iter().map(|p| {
-                    EmptyElement::at((p.0, p.1))
-                        + Circle::new((0, 0), 5, c.filled())
-                        + Text::new(format!("{}", p.2), (7, -18), text.clone())
-                }))
-                .map_err(de)?;
+            labelled_dots(&mut chart, &pts, c)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(de)
+        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
 
