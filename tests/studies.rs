@@ -146,13 +146,13 @@ fn sweep_runs_two_variants_resumes_and_charts() {
     assert!(steps("CFL 0.5") < steps("seed (quintic, CFL 0.3)"));
     // Resuming with nothing left to do rewrites every file from the rows it has.
     std::fs::remove_file(dir.path().join("sweep.csv")).unwrap();
-    std::fs::remove_file(dir.path().join("sweep.png")).unwrap();
+    std::fs::remove_file(dir.path().join("speed-accuracy.png")).unwrap();
     ok(&grit(
         &[&common[..], &["--ppd", "8,9", "--resume"]].concat(),
     ));
     let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5);
-    png_ok(&dir.path().join("sweep.png"));
+    png_ok(&dir.path().join("speed-accuracy.png"));
 }
 
 #[test]

@@ -303,8 +303,8 @@ enum BenchWhat {
     },
     /// The speed–accuracy sweep: erosion of the hexagon (samples × impacts) and the Hertz p0
     /// error at several resolutions and numerical variants, against wall time per impact.
-    /// Writes OUT/sweep.{csv,json,png,svg} and names the cheapest setting within the finest's
-    /// error bars.
+    /// Writes OUT/sweep.{csv,json} and the chart OUT/speed-accuracy.{png,svg}, and names the
+    /// cheapest setting within the finest's error bars.
     Sweep {
         /// Impact angle (degrees).
         #[arg(long, default_value_t = 45.0)]
@@ -882,7 +882,7 @@ fn bench_sweep(args: crate::studies::SweepArgs, threads: Option<usize>) -> CliRe
         None => say!("no erosion at the finest resolution: no setting can be judged against it"),
     }
     say!(
-        "wrote {0}/sweep.csv, .json, .png and .svg",
+        "wrote {0}/sweep.csv, {0}/sweep.json and {0}/speed-accuracy.png, .svg",
         args.out.display()
     );
     Ok(ExitCode::SUCCESS)

@@ -198,7 +198,8 @@ pub struct SweepArgs {
     pub resume: bool,
 }
 
-/// Runs the sweep and writes `sweep.csv`, `.json`, `.png` and `.svg` into `out`; rows are
+/// Runs the sweep and writes `sweep.csv`, `sweep.json` and the chart `speed-accuracy.png`/`.svg`
+/// into `out`; rows are
 /// written after every resolution, so an interrupted sweep keeps what it finished.
 pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
     if a.ppd.is_empty() || a.ppd.iter().any(|p| !(p.is_finite() && *p >= 6.0)) {
@@ -303,7 +304,7 @@ pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
             Cost::of(&rows).label()
         ));
     }
-    grit_plot::sweep_chart(&rows, &a.out, "sweep", &notes).map_err(|e| e.to_string())?;
+    grit_plot::sweep_chart(&rows, &a.out, "speed-accuracy", &notes).map_err(|e| e.to_string())?;
     Ok(rows)
 }
 

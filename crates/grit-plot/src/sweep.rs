@@ -218,7 +218,7 @@ impl Sweep<'_> {
                 });
             labelled_dots(&mut chart, &pts, c)?;
         }
-        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+        legend_box(&mut chart, SeriesLabelPosition::LowerLeft)
     }
 }
 
