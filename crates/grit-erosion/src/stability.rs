@@ -123,6 +123,14 @@ pub enum Panel {
 }
 
 impl Panel {
+    /// The panel's vertical axis value of a point: hourglass α, or the stiffness scale.
+    pub fn y(self, p: &StabilityPoint) -> f64 {
+        match self {
+            Panel::CflHourglass => p.hourglass,
+            _ => p.stiffness_scale,
+        }
+    }
+
     /// The contact model the panel runs.
     pub fn contact_model(self) -> ContactModel {
         match self {
@@ -130,6 +138,14 @@ impl Panel {
             _ => ContactModel::Extrapolated,
         }
     }
+}
+
+/// The distinct values of one axis of a panel, ascending.
+pub fn levels(v: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut v: Vec<f64> = v.collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
 }
 
 /// One point of the map: the choices tried and how the impact went.

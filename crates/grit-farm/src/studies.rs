@@ -75,16 +75,9 @@ pub fn stability_table(points: &[StabilityPoint]) -> String {
         if pts.is_empty() {
             continue;
         }
-        let y = |p: &StabilityPoint| match panel {
-            Panel::CflHourglass => p.hourglass,
-            _ => p.stiffness_scale,
-        };
-        let mut cfl: Vec<f64> = pts.iter().map(|p| p.cfl).collect();
-        cfl.sort_by(f64::total_cmp);
-        cfl.dedup();
-        let mut ys: Vec<f64> = pts.iter().map(|p| y(p)).collect();
-        ys.sort_by(f64::total_cmp);
-        ys.dedup();
+        let y = |p: &StabilityPoint| panel.y(p);
+        let cfl = stability::levels(pts.iter().map(|p| p.cfl));
+        let ys = stability::levels(pts.iter().map(|p| y(p)));
         let (name, yname) = match panel {
             Panel::CflHourglass => ("Courant number × hourglass α, seed contact", "α"),
             Panel::StiffnessStep => ("stiffness × step, seed contact", "k/k0"),
@@ -148,8 +141,24 @@ pub fn stability(a: &StabilityArgs) -> Result<Vec<StabilityPoint>, String> {
         ));
         let p =
             stability::run_point(&from, panel, n, a.budget_factor).map_err(|e| e.to_string())?;
-        points.push(p);
         pb.inc(1);
+        progress_line(
+            &pb,
+            &format!(
+                "{}/{} {:?}: cfl {} α {} k×{}: {:?}{}",
+                pb.position(),
+                pb.length().unwrap_or(0),
+                panel,
+                n.cfl,
+                n.hourglass,
+                n.contact_stiffness_scale,
+                p.verdict,
+                p.failure
+                    .map(|f| format!(" ({})", f.label()))
+                    .unwrap_or_default()
+            ),
+        );
+        points.push(p);
     }
     pb.finish_and_clear();
     write_csv(&a.out, "stability", &points)?;
@@ -165,6 +174,16 @@ pub fn stability(a: &StabilityArgs) -> Result<Vec<StabilityPoint>, String> {
     )];
     grit_plot::stability_chart(&points, &a.out, "stability", &notes).map_err(|e| e.to_string())?;
     Ok(points)
+}
+
+/// Prints one line of progress above the bar, or on its own where the bar is hidden (output not
+/// a terminal, as in a log file), since a hidden bar prints nothing.
+fn progress_line(pb: &ProgressBar, line: &str) {
+    if pb.is_hidden() {
+        println!("{line}");
+    } else {
+        pb.println(line);
+    }
 }
 
 /// The reference scene of issue 5 at another spacing and angle.
@@ -199,8 +218,8 @@ pub struct SweepArgs {
 }
 
 /// Runs the sweep and writes `sweep.csv`, `sweep.json` and the chart `speed-accuracy.png`/`.svg`
-/// into `out`; rows are
-/// written after every resolution, so an interrupted sweep keeps what it finished.
+/// into `out`; rows are written after every resolution, so an interrupted sweep keeps what it
+/// finished.
 pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
     if a.ppd.is_empty() || a.ppd.iter().any(|p| !(p.is_finite() && *p >= 6.0)) {
         return Err("--ppd: give resolutions of at least 6 particles per Dg".into());
@@ -271,12 +290,7 @@ pub fn sweep(a: &SweepArgs) -> Result<Vec<SweepRow>, String> {
             &a.params, v, ppd, a.samples, a.impacts, a.seed, &tick,
         )
         .map_err(|e| format!("{} at {ppd} per Dg: {e}", v.name()))?;
-        // A hidden bar (output not a terminal, as in a log file) prints nothing of its own.
-        if pb.is_hidden() {
-            println!("{}", sweep_line(&row));
-        } else {
-            pb.println(sweep_line(&row));
-        }
+        progress_line(&pb, &sweep_line(&row));
         rows.push(row);
         write_csv(&a.out, "sweep", &rows)?;
         write_json(&a.out, "sweep", &rows)?;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use grit_erosion::stability::{spring_limit_cfl, Failure, Panel, StabilityPoint, Verdict};
+use grit_erosion::stability::{levels, spring_limit_cfl, Failure, Panel, StabilityPoint, Verdict};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -24,13 +24,6 @@ struct Map<'a> {
 }
 
 /// Sorted distinct values.
-fn levels(v: impl Iterator<Item = f64>) -> Vec<f64> {
-    let mut v: Vec<f64> = v.collect();
-    v.sort_by(f64::total_cmp);
-    v.dedup();
-    v
-}
-
 fn tick(v: &SegmentValue<i32>, values: &[f64]) -> String {
     match v {
         SegmentValue::CenterOf(i) | SegmentValue::Exact(i) => values
@@ -60,10 +53,7 @@ fn panel<DB: DrawingBackend>(
             "contact stiffness / default k (eqs. 24–25)",
         ),
     };
-    let yv = |p: &StabilityPoint| match which {
-        Panel::CflHourglass => p.hourglass,
-        _ => p.stiffness_scale,
-    };
+    let yv = |p: &StabilityPoint| which.y(p);
     let xs = levels(points.iter().map(|p| p.cfl));
     let ys = levels(points.iter().map(|p| yv(p)));
     let at = |v: &[f64], x: f64| v.iter().position(|&u| u == x).unwrap_or(0) as i32;
