@@ -13,7 +13,7 @@ use crate::impact::{
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
-pub const CHECKPOINT_VERSION: u32 = 3;
+pub const CHECKPOINT_VERSION: u32 = 4;
 
 /// One impact of a sample as reported to the farm and printed by `grit sample`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

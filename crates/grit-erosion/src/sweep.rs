@@ -23,21 +23,25 @@ pub enum Variant {
     WendlandC2,
     /// The seed's numerics at another Courant number.
     Cfl(f64),
+    /// The seed's numerics with the grain's approach flight simulated step by step, as before
+    /// the flight skip (`Numerics::skip_flight`) became the default.
+    FullFlight,
 }
 
 impl Variant {
-    /// Parses `seed`, `wendland_c2` or `cfl=X`.
+    /// Parses `seed`, `wendland_c2`, `full_flight` or `cfl=X`.
     pub fn parse(s: &str) -> Result<Variant, String> {
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
+            "full_flight" => Ok(Variant::FullFlight),
             other => match other.strip_prefix("cfl=").map(str::parse::<f64>) {
                 Some(Ok(c)) if c > 0.0 && c <= grit_sph::world::MAX_CFL => Ok(Variant::Cfl(c)),
                 Some(_) => Err(format!(
                     "--variants: `{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => Err(format!(
-                    "--variants: unknown variant `{other}` (known: seed, wendland_c2, cfl=X)"
+                    "--variants: unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X)"
                 )),
             },
         }
@@ -49,6 +53,7 @@ impl Variant {
             Variant::Seed => "seed (quintic, CFL 0.3)".into(),
             Variant::WendlandC2 => "Wendland C2".into(),
             Variant::Cfl(c) => format!("CFL {c}"),
+            Variant::FullFlight => "seed, flight simulated".into(),
         }
     }
 
@@ -62,6 +67,10 @@ impl Variant {
                 ..base
             },
             Variant::Cfl(cfl) => Numerics { cfl, ..base },
+            Variant::FullFlight => Numerics {
+                skip_flight: false,
+                ..base
+            },
         }
     }
 }
@@ -71,6 +80,9 @@ impl Variant {
 pub struct SweepRow {
     /// Variant name.
     pub variant: String,
+    /// Impact angle (degrees); absent in rows written before it was recorded (all at 45°).
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
     /// Particles per grain diameter, Dg/Δx.
     pub particles_per_dg: f64,
     /// Particle spacing Δx (m).
@@ -191,6 +203,7 @@ pub fn run_resolution(
     };
     Ok(SweepRow {
         variant: variant.name(),
+        angle_deg: Some(params.angle_deg),
         particles_per_dg: ppd,
         spacing_m: params.spacing_m,
         surface_depth_dg: params.surface_depth_dg,
@@ -288,6 +301,7 @@ mod tests {
     fn row(variant: &str, ppd: f64, e: Option<f64>, std: f64, wall: f64) -> SweepRow {
         SweepRow {
             variant: variant.into(),
+            angle_deg: Some(45.0),
             particles_per_dg: ppd,
             spacing_m: 250e-6 / ppd,
             surface_depth_dg: 1.25,

@@ -56,8 +56,10 @@ fn a_grazing_grain_aimed_at_the_upstream_end_still_hits() {
     for u_angle in [0.0, 0.3, 0.7] {
         let grain = p.grain_start(u_angle, 0.0).unwrap();
         let run = run_impact(&p, &surface, &grain, &|| false).unwrap();
+        // It hit: it lost speed and left the surface plastically deformed.
+        let deformed = run.surface.eps_p.iter().any(|&e| e > 1e-3);
         assert!(
-            run.outcome.rebound_ratio < 0.98 && run.outcome.steps > 500,
+            run.outcome.rebound_ratio < 0.98 && deformed,
             "orientation {u_angle}: {:?}",
             run.outcome
         );
