@@ -282,32 +282,14 @@ enum BenchWhat {
     /// One impact of the reference scene (hexagon, 45°, 100 m/s, AISI 304, 8 µm) timed on 1
     /// thread and on N threads from the same surface: particle-steps per second and stages.
     Impact {
-        /// Impact angle (degrees).
-        #[arg(long, default_value_t = 45.0)]
-        angle: f64,
-        /// Particle spacing Δx (m); 8e-6 is the reference, coarser ones are quicker.
-        #[arg(long, default_value_t = 8e-6)]
-        spacing_m: f64,
-        /// Impacts the surface takes before the timed one (the issue's second scene: 30).
-        #[arg(long, default_value_t = 0)]
-        after: u32,
-        /// Seed of the sample.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
+        #[command(flatten)]
+        scene: ImpactScene,
         /// Threads of the timed run (1 is always timed too).
         #[arg(long, default_value_t = 2)]
         threads: usize,
         /// Print the figures as JSON.
         #[arg(long)]
         json: bool,
-        /// Simulate every particle of the grain, not only its outline (the model before the
-        /// grain-shell saving; the results are bitwise the same, the cost is not).
-        #[arg(long)]
-        full_grain: bool,
-        /// Simulate the grain's approach step by step instead of skipping to just before its
-        /// first contact (the model before the flight skip).
-        #[arg(long)]
-        full_flight: bool,
     },
     /// The speed–accuracy sweep: erosion of the hexagon (samples × impacts) and the Hertz p0
     /// error at several resolutions and numerical variants, against wall time per impact.
@@ -792,14 +774,28 @@ async fn results(a: ResultsArgs) -> CliResult {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `grit bench impact`: synchronous, the engine runs on rayon pools of its own.
-/// The scene `grit bench impact` times.
-struct ImpactScene {
+/// The scene `grit bench impact` times: issue 5's reference scene, or a variant of it.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ImpactScene {
+    /// Impact angle (degrees).
+    #[arg(long, default_value_t = 45.0)]
     angle: f64,
+    /// Particle spacing Δx (m); 8e-6 is the reference, coarser ones are quicker.
+    #[arg(long, default_value_t = 8e-6)]
     spacing_m: f64,
+    /// Impacts the surface takes before the timed one (the issue's second scene: 30).
+    #[arg(long, default_value_t = 0)]
     after: u32,
+    /// Seed of the sample.
+    #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Simulate every particle of the grain, not only its outline (the model before the
+    /// grain-shell saving; the results are bitwise the same, the cost is not).
+    #[arg(long)]
     full_grain: bool,
+    /// Simulate the grain's approach step by step instead of skipping to just before its
+    /// first contact (the model before the flight skip).
+    #[arg(long)]
     full_flight: bool,
 }
 
@@ -810,6 +806,7 @@ async fn blocking(f: impl FnOnce() -> CliResult + Send + 'static) -> CliResult {
         .map_err(|e| CliError(format!("benchmark thread: {e}")))?
 }
 
+/// `grit bench impact`: synchronous, the engine runs on rayon pools of its own.
 fn bench_impact(scene: ImpactScene, threads: usize, json: bool) -> CliResult {
     use grit_erosion::{ImpactParams, Sample, Shape};
     let ImpactScene {
@@ -993,23 +990,10 @@ async fn bench(a: BenchArgs) -> CliResult {
             return blocking(move || bench_stability(args, threads)).await;
         }
         BenchWhat::Impact {
-            angle,
-            spacing_m,
-            after,
-            seed,
+            scene,
             threads,
             json,
-            full_grain,
-            full_flight,
         } => {
-            let scene = ImpactScene {
-                angle,
-                spacing_m,
-                after,
-                seed,
-                full_grain,
-                full_flight,
-            };
             return blocking(move || bench_impact(scene, threads, json)).await;
         }
     };
