@@ -1,5 +1,6 @@
-//! `grit bench stability` and `grit bench sweep` at CI size: they run, mark what fails, write
-//! their CSV, JSON and charts, resume without redoing points, and refuse bad input clearly.
+//! `grit bench impact`, `grit bench stability` and `grit bench sweep` at CI size: they run, mark
+//! what fails, write their CSV, JSON and charts, resume without redoing points, and refuse bad
+//! input clearly.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -159,7 +160,15 @@ fn sweep_runs_two_variants_resumes_and_charts() {
 fn studies_refuse_bad_input_naming_the_option() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 8] = [
+        (
+            &["bench", "impact", "--repeat", "0"],
+            "--repeat: must be at least 1",
+        ),
+        (
+            &["bench", "impact", "--threads", "0"],
+            "--threads: must be at least 1",
+        ),
         (
             &["bench", "stability", "--cfl", "0.3,3", "--out", out],
             "--cfl: 3",
@@ -189,4 +198,43 @@ fn studies_refuse_bad_input_naming_the_option() {
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
+}
+
+/// The figures and JSON names issue 5 fixes, from a coarse impact timed twice each way; the
+/// grain shell and flight skip are on by default and can be turned off.
+#[test]
+fn impact_bench_prints_the_issue_fields_with_medians_of_repeats() {
+    let run = |extra: &[&str]| -> serde_json::Value {
+        let args = [
+            &["bench", "impact", "--spacing-m", COARSE, "--json"][..],
+            extra,
+        ]
+        .concat();
+        serde_json::from_str(&ok(&grit(&args))).expect("JSON")
+    };
+    let v = run(&["--repeat", "2"]);
+    for key in [
+        "particles",
+        "steps",
+        "wall_s",
+        "particle_steps_per_s",
+        "particle_steps_per_s_per_thread",
+        "threads",
+        "speedup_1_to_2",
+        "stages",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    assert_eq!(v["repeats"], 2);
+    let runs = v["wall_s_runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    let (a, b) = (runs[0].as_f64().unwrap(), runs[1].as_f64().unwrap());
+    assert!((v["wall_s"].as_f64().unwrap() - 0.5 * (a + b)).abs() < 1e-12);
+    for stage in ["kernel_sums", "forces", "stress", "contact", "neighbours"] {
+        assert!(v["stages"][stage].as_f64().unwrap() > 0.0, "{stage}: {v}");
+    }
+    // The old model: every grain particle, and the flight simulated step by step.
+    let full = run(&["--full-grain", "--full-flight"]);
+    assert!(full["particles"].as_u64() > v["particles"].as_u64());
+    assert!(full["steps"].as_u64() > v["steps"].as_u64());
 }

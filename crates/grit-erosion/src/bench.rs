@@ -23,19 +23,48 @@ pub struct ImpactBench {
     pub particle_steps_per_s_per_thread: f64,
     /// Threads of the timed run.
     pub threads: usize,
-    /// Wall time on 1 thread over wall time on 2 threads, same impact, same run.
+    /// Wall time on 1 thread over wall time on 2 threads, same impact, same run (the median of
+    /// the repeats' ratios).
     pub speedup_1_to_2: Option<f64>,
     /// Wall time on 1 thread (s).
     pub wall_1_thread_s: f64,
-    /// Seconds per engine stage on `threads` threads.
+    /// Repeats: 1-thread and `threads`-thread runs alternate this many times; the wall times
+    /// above are medians.
+    #[serde(default = "one")]
+    pub repeats: usize,
+    /// Wall time of each repeat on `threads` threads (s), in run order.
+    #[serde(default)]
+    pub wall_s_runs: Vec<f64>,
+    /// Wall time of each repeat on 1 thread (s), in run order.
+    #[serde(default)]
+    pub wall_1_thread_s_runs: Vec<f64>,
+    /// Seconds per engine stage on `threads` threads (the last repeat).
     pub stages: BTreeMap<String, f64>,
     /// Impacts the surface had taken before the timed one.
     pub surface_impacts: u32,
 }
 
+fn one() -> usize {
+    1
+}
+
+/// The middle value (the mean of the two middle ones for an even count).
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
 /// Times the next impact of `sample` on 1 thread and on `threads` threads, each from a copy of
-/// the same state, so both runs do bitwise the same work (the engine is deterministic).
-pub fn impact(sample: &Sample, threads: usize) -> Result<ImpactBench, SampleError> {
+/// the same state, so both runs do bitwise the same work (the engine is deterministic). The two
+/// alternate `repeats` times and the figures are medians: on a shared machine one pair of runs
+/// can give a speed-up anywhere from 1.4 to 1.9 (docs/performance.md).
+pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactBench, SampleError> {
     let timed = |n: usize| -> Result<(f64, Sample), SampleError> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -46,12 +75,23 @@ pub fn impact(sample: &Sample, threads: usize) -> Result<ImpactBench, SampleErro
         pool.install(|| s.run_next().map(|_| ()))?;
         Ok((t0.elapsed().as_secs_f64(), s))
     };
-    let (wall1, one) = timed(1)?;
-    let (wall, many) = if threads == 1 {
-        (wall1, one)
-    } else {
-        timed(threads)?
-    };
+    let repeats = repeats.max(1);
+    let (mut walls1, mut walls, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    let mut last = None;
+    for _ in 0..repeats {
+        let (wall1, one) = timed(1)?;
+        let (wall, many) = if threads == 1 {
+            (wall1, one)
+        } else {
+            timed(threads)?
+        };
+        walls1.push(wall1);
+        walls.push(wall);
+        ratios.push(wall1 / wall);
+        last = Some(many);
+    }
+    let many = last.expect("at least one repeat ran");
+    let (wall, wall1) = (median(&walls), median(&walls1));
     let r = many.records().last().expect("one impact ran");
     let particles = many.last_particles();
     let ps = particles as f64 * r.outcome.steps as f64;
@@ -62,8 +102,11 @@ pub fn impact(sample: &Sample, threads: usize) -> Result<ImpactBench, SampleErro
         particle_steps_per_s: ps / wall,
         particle_steps_per_s_per_thread: ps / wall / threads as f64,
         threads,
-        speedup_1_to_2: (threads == 2).then(|| wall1 / wall),
+        speedup_1_to_2: (threads == 2).then(|| median(&ratios)),
         wall_1_thread_s: wall1,
+        repeats,
+        wall_s_runs: walls,
+        wall_1_thread_s_runs: walls1,
         stages: many
             .last_timers()
             .breakdown()
@@ -72,4 +115,16 @@ pub fn impact(sample: &Sample, threads: usize) -> Result<ImpactBench, SampleErro
             .collect(),
         surface_impacts: sample.impacts_done(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(&[7.0]), 7.0);
+    }
 }

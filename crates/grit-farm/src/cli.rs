@@ -287,6 +287,9 @@ enum BenchWhat {
         /// Threads of the timed run (1 is always timed too).
         #[arg(long, default_value_t = 2)]
         threads: usize,
+        /// Alternate the 1-thread and the N-thread run this many times and report medians.
+        #[arg(long, default_value_t = 1)]
+        repeat: usize,
         /// Print the figures as JSON.
         #[arg(long)]
         json: bool,
@@ -807,7 +810,7 @@ async fn blocking(f: impl FnOnce() -> CliResult + Send + 'static) -> CliResult {
 }
 
 /// `grit bench impact`: synchronous, the engine runs on rayon pools of its own.
-fn bench_impact(scene: ImpactScene, threads: usize, json: bool) -> CliResult {
+fn bench_impact(scene: ImpactScene, threads: usize, repeat: usize, json: bool) -> CliResult {
     use grit_erosion::{ImpactParams, Sample, Shape};
     let ImpactScene {
         angle,
@@ -819,6 +822,9 @@ fn bench_impact(scene: ImpactScene, threads: usize, json: bool) -> CliResult {
     } = scene;
     if threads == 0 {
         return Err(CliError("--threads: must be at least 1".into()));
+    }
+    if repeat == 0 {
+        return Err(CliError("--repeat: must be at least 1".into()));
     }
     let mut params = ImpactParams {
         spacing_m,
@@ -834,7 +840,8 @@ fn bench_impact(scene: ImpactScene, threads: usize, json: bool) -> CliResult {
         eprintln!("preparing the surface: impact {} of {after}", k + 1);
         s.run_next().map_err(|e| CliError(e.to_string()))?;
     }
-    let b = grit_erosion::bench::impact(&s, threads).map_err(|e| CliError(e.to_string()))?;
+    let b =
+        grit_erosion::bench::impact(&s, threads, repeat).map_err(|e| CliError(e.to_string()))?;
     if json {
         say!("{}", serde_json::to_string_pretty(&b).expect("serialises"));
         return Ok(ExitCode::SUCCESS);
@@ -846,6 +853,24 @@ fn bench_impact(scene: ImpactScene, threads: usize, json: bool) -> CliResult {
     );
     say!("particles                 {}", b.particles);
     say!("steps                     {}", b.steps);
+    let runs = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if b.repeats > 1 {
+        say!("repeats                   {} (medians below)", b.repeats);
+        say!(
+            "wall runs ({} threads)     {} s",
+            b.threads,
+            runs(&b.wall_s_runs)
+        );
+        say!(
+            "wall runs (1 thread)      {} s",
+            runs(&b.wall_1_thread_s_runs)
+        );
+    }
     say!("wall ({} threads)          {:.2} s", b.threads, b.wall_s);
     say!("wall (1 thread)           {:.2} s", b.wall_1_thread_s);
     say!("particle-steps/s          {:.3e}", b.particle_steps_per_s);
@@ -992,9 +1017,10 @@ async fn bench(a: BenchArgs) -> CliResult {
         BenchWhat::Impact {
             scene,
             threads,
+            repeat,
             json,
         } => {
-            return blocking(move || bench_impact(scene, threads, json)).await;
+            return blocking(move || bench_impact(scene, threads, repeat, json)).await;
         }
     };
     if clients.is_empty() || clients.contains(&0) {
