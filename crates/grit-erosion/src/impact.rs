@@ -556,8 +556,10 @@ pub fn flight_to_contact(params: &ImpactParams, surface: &Particles, grain: &Gra
         .iter()
         .map(|x| x.y)
         .fold(f64::NEG_INFINITY, f64::max);
-    // The lowest outline particle sinks |dir.y| per metre of path: past `limit` it is below
-    // the highest surface particle by the reach, and contact must have started.
+    // The lowest outline particle sinks |dir.y| per metre of path. The search stops at `limit`,
+    // where it is the reach below the highest surface particle: over a flat surface contact has
+    // begun by then; over a crater it may not have, and the grain is left there, every probe
+    // before it having been clear.
     let limit = if dir.y < 0.0 {
         (lowest - top + reach) / -dir.y
     } else {

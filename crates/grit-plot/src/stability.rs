@@ -23,7 +23,7 @@ struct Map<'a> {
     notes: Vec<String>,
 }
 
-/// Sorted distinct values.
+/// The label of a segmented-axis tick: the value of the level it marks.
 fn tick(v: &SegmentValue<i32>, values: &[f64]) -> String {
     match v {
         SegmentValue::CenterOf(i) | SegmentValue::Exact(i) => values
