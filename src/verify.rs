@@ -32,9 +32,9 @@ pub struct Args {
 /// (they show where a method fails, and failing is their point).
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (slope_n, slide_n, impact_n, hg_n) = if a.quick {
-        (20, 20, 20, 20)
+        (20, 20, 40, 20)
     } else {
-        (40, 40, 60, 40)
+        (40, 40, 80, 40)
     };
     // Particles per cylinder radius, coarse to fine: the convergence of p0 needs three.
     let hertz_n: &'static [usize] = if a.quick {

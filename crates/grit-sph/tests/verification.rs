@@ -31,14 +31,15 @@ fn penetration_contact_fails_the_2_percent_bound() {
 }
 
 #[test]
-fn elastic_impact_conserves_momentum() {
-    let r = elastic_impact::run(20).unwrap();
-    let m = r
-        .rows
-        .iter()
-        .find(|r| r.case == "elastic_impact_momentum")
-        .unwrap();
-    assert!(m.pass, "{m:?}");
+fn elastic_impact_conserves_momentum_and_energy_at_40_per_side() {
+    // The three bounds, with the seed's filter and hourglass control on: momentum to
+    // 1e-8, peak E/E0 at most 1.01, E/E0 after contact within 5 %. 30 per side misses the
+    // last by 0.2 % (docs/verification.md §6), so the CI resolution is 40.
+    let r = elastic_impact::run(40).unwrap();
+    assert_eq!(r.rows.len(), 3);
+    for row in &r.rows {
+        assert!(row.pass, "{row:?}");
+    }
 }
 
 #[test]

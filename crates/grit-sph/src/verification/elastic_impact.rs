@@ -14,10 +14,9 @@ use crate::world::{NumericalWork, Settings, World};
 
 /// Block side (m).
 pub const BLOCK: f64 = 0.01;
-/// Disc radius (m).
-pub const RADIUS: f64 = 0.002;
-/// Impact speed (m/s).
-pub const SPEED: f64 = 20.0;
+/// The run ends once the disc has left and flown this far (m) at its impact speed; it is a
+/// distance rather than disc radii so that a larger disc does not mean a longer wait.
+pub const FLIGHT: f64 = 0.004;
 
 /// Time history of one run.
 #[derive(Debug, Clone, Default)]
@@ -53,14 +52,35 @@ pub struct Disc {
     pub density_kg_m3: f64,
 }
 
+impl Disc {
+    /// The first version of the case: a 2 mm steel disc at 20 m/s. Its Hertz contact is narrower
+    /// than one particle spacing at any affordable resolution, so the seed's density filter
+    /// (eq. 12) takes 16 % of the energy (docs/verification.md §6); the zero-energy-mode case
+    /// keeps it, because a load on one or two particles is what excites those modes.
+    pub const SMALL: Disc = Disc {
+        radius_m: 0.002,
+        speed_m_s: 20.0,
+        density_kg_m3: 7800.0,
+    };
+}
+
 impl Default for Disc {
+    /// The verification disc: radius 1.5 block sides, so that the Hertz contact spans several
+    /// particle spacings; the erosion scenes' 100 m/s; as heavy as the block.
     fn default() -> Self {
+        let radius_m = 1.5 * BLOCK;
+        let block_mass = Material::elastic_aluminium().density_kg_m3 * BLOCK * BLOCK;
         Disc {
-            radius_m: RADIUS,
-            speed_m_s: SPEED,
-            density_kg_m3: 7800.0,
+            radius_m,
+            speed_m_s: 100.0,
+            density_kg_m3: block_mass / disc_polygon(radius_m).area(),
         }
     }
+}
+
+/// The disc's outline, centred on the origin.
+fn disc_polygon(radius_m: f64) -> Polygon {
+    Polygon::regular(64, radius_m, 0.0)
 }
 
 /// Builds the scene with `n` particles along the block side.
@@ -86,7 +106,7 @@ pub fn scene_with(n: usize, settings: Settings, disc: Disc) -> World {
             Vector::zeros(),
         )
         .expect("block");
-    let polygon = Polygon::regular(64, disc.radius_m, 0.0)
+    let polygon = disc_polygon(disc.radius_m)
         .translated(Vector::new(0.5 * BLOCK, BLOCK + disc.radius_m + dx));
     let d = w
         .add_rigid(
@@ -103,12 +123,12 @@ pub fn scene_with(n: usize, settings: Settings, disc: Disc) -> World {
     w
 }
 
-/// Runs until the disc has left the block and travelled two further radii.
+/// Runs until the disc has left the block and flown `FLIGHT` further.
 pub fn simulate(n: usize, settings: Settings) -> Result<History, SimError> {
     simulate_until(n, settings, None)
 }
 
-/// Runs to `t_end` (s) if given, else until the disc has left and travelled two radii.
+/// Runs to `t_end` (s) if given, else until the disc has left and flown `FLIGHT`.
 pub fn simulate_until(
     n: usize,
     settings: Settings,
@@ -134,9 +154,8 @@ pub fn simulate_with(
     };
     let mut touched = false;
     let mut left_at = None;
-    // Flight distances, not disc radii: a larger disc should not mean a longer wait.
     let speed = disc.speed_m_s;
-    let t_max = t_end.unwrap_or(40.0 * RADIUS / speed);
+    let t_max = t_end.unwrap_or(20.0 * FLIGHT / speed);
     while w.time() < t_max {
         w.step()?;
         let touching = w.contact_forces().iter().any(|f| f.norm() > 0.0);
@@ -160,7 +179,7 @@ pub fn simulate_with(
             h.in_contact.push(touching);
         }
         if let (Some(t), None) = (left_at, t_end) {
-            if w.time() > t + 2.0 * RADIUS / speed {
+            if w.time() > t + FLIGHT / speed {
                 break;
             }
         }
@@ -210,9 +229,12 @@ pub fn run(n: usize) -> Result<CaseReport, SimError> {
         pass: (e_after - 1.0).abs() <= 0.05,
         expected_fail: false,
         note: format!(
-            "E/E0 two disc radii of flight after release; bound 5%; E/E0 at release {:.4}; \
+            "E/E0 after {:.0} mm of flight past release; bound 5%; E/E0 at release {:.4}; \
              work over the run: density filter {:.4} E0, hourglass {:.4} E0",
-            h.at_release, h.work.density_filter, h.work.hourglass
+            FLIGHT * 1e3,
+            h.at_release,
+            h.work.density_filter,
+            h.work.hourglass
         ),
     });
     let budget: Vec<f64> = h
