@@ -7,29 +7,8 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
-use grit_erosion::impact::impact_world;
-use grit_erosion::{ImpactParams, Shape};
-use grit_sph::{Stage, World};
-
-/// The impact scene at `spacing_m`, stepped until the grain has pressed into the surface for
-/// `contact_steps` steps.
-fn mid_contact(spacing_m: f64, contact_steps: u32) -> World {
-    let params = ImpactParams {
-        spacing_m,
-        ..ImpactParams::paper(45.0, Shape::Hexagon)
-    };
-    let surface = params.fresh_surface().expect("valid scene");
-    let grain = params.grain_start(0.3, 0.5).expect("valid grain");
-    let mut w = impact_world(&params, &surface, &grain).expect("valid scene");
-    let mut touching = 0;
-    while touching < contact_steps {
-        w.step().expect("stable");
-        if w.contact_forces().iter().any(|f| f.norm() > 0.0) {
-            touching += 1;
-        }
-    }
-    w
-}
+use grit_erosion::impact::mid_contact_world;
+use grit_sph::Stage;
 
 fn stages(c: &mut Criterion) {
     let stages = [
@@ -41,7 +20,7 @@ fn stages(c: &mut Criterion) {
         ("contact", Stage::Contact),
     ];
     for (label, spacing) in [("16um", 16e-6), ("8um", 8e-6)] {
-        let mut w = mid_contact(spacing, 100);
+        let mut w = mid_contact_world(spacing, 100).expect("a stable scene");
         // Fills the caches the later stages read, so every stage is timed on its own.
         w.run_stage(Stage::Rates).expect("a step stage");
         let mut group = c.benchmark_group(format!("stage_{label}_{}p", w.particles().len()));

@@ -430,6 +430,27 @@ pub fn impact_world(
     Ok(world)
 }
 
+/// The reference impact (seed section 4: hexagon, 45°, 100 m/s, AISI 304) at `spacing_m` on a
+/// fresh surface, stepped until the grain has pressed on it for `contact_steps` steps: the state
+/// the stage benchmarks time (issue 5).
+pub fn mid_contact_world(spacing_m: f64, contact_steps: u32) -> Result<World, ImpactError> {
+    let params = ImpactParams {
+        spacing_m,
+        ..ImpactParams::paper(45.0, Shape::Hexagon)
+    };
+    let surface = params.fresh_surface()?;
+    let grain = params.grain_start(0.3, 0.5)?;
+    let mut w = impact_world(&params, &surface, &grain)?;
+    let mut touching = 0;
+    while touching < contact_steps {
+        w.step()?;
+        if w.contact_forces().iter().any(|f| f.norm() > 0.0) {
+            touching += 1;
+        }
+    }
+    Ok(w)
+}
+
 /// A read-only look at the world after every step of an impact (surface body 0, grain body 1).
 pub type StepObserver<'a> = &'a mut dyn FnMut(&World);
 
