@@ -66,6 +66,9 @@ pub struct Numerics {
     /// Move the grain along its straight, force-free path to just before its first contact
     /// instead of simulating the flight step by step (issue 5, "model no more").
     pub skip_flight: bool,
+    /// Keep the surface's particles in Z-order of neighbour cells (`Settings::cell_order`;
+    /// issue 5, "model no more"): results differ by rounding only.
+    pub cell_order: bool,
 }
 
 impl Default for Numerics {
@@ -81,6 +84,7 @@ impl Default for Numerics {
             // Ours, not the seed's: bitwise the same results at less cost (tests/sample.rs).
             grain_shell: true,
             skip_flight: true,
+            cell_order: s.cell_order,
         }
     }
 }
@@ -226,6 +230,7 @@ impl ImpactParams {
             hourglass: n.hourglass,
             contact_limits_dt: n.contact_limits_dt,
             rigid_shell: n.grain_shell,
+            cell_order: n.cell_order,
             ..Settings::default()
         }
     }

@@ -800,6 +800,10 @@ pub struct ImpactScene {
     /// first contact (the model before the flight skip).
     #[arg(long)]
     full_flight: bool,
+    /// Keep the surface's particles in Z-order of neighbour cells, re-sorted at every
+    /// neighbour rebuild (an option under test; results differ by rounding only).
+    #[arg(long)]
+    cell_order: bool,
 }
 
 /// Runs a benchmark on tokio's blocking pool: it holds its thread for minutes.
@@ -819,6 +823,7 @@ fn bench_impact(scene: ImpactScene, threads: usize, repeat: usize, json: bool) -
         seed,
         full_grain,
         full_flight,
+        cell_order,
     } = scene;
     if threads == 0 {
         return Err(CliError("--threads: must be at least 1".into()));
@@ -832,6 +837,7 @@ fn bench_impact(scene: ImpactScene, threads: usize, repeat: usize, json: bool) -
     };
     params.numerics.grain_shell &= !full_grain;
     params.numerics.skip_flight &= !full_flight;
+    params.numerics.cell_order |= cell_order;
     params
         .validate()
         .map_err(|e| CliError(format!("{}: {}", e.field, e.rule)))?;
@@ -847,9 +853,10 @@ fn bench_impact(scene: ImpactScene, threads: usize, repeat: usize, json: bool) -
         return Ok(ExitCode::SUCCESS);
     }
     say!(
-        "scene: hexagon {angle} deg, 100 m/s, AISI 304, spacing {spacing_m:e} m, surface after {after} impacts, grain {}, flight {}",
+        "scene: hexagon {angle} deg, 100 m/s, AISI 304, spacing {spacing_m:e} m, surface after {after} impacts, grain {}, flight {}, particles in {} order",
         if full_grain { "filled" } else { "outline only" },
-        if full_flight { "simulated" } else { "skipped" }
+        if full_flight { "simulated" } else { "skipped" },
+        if cell_order { "cell" } else { "creation" }
     );
     say!("particles                 {}", b.particles);
     say!("steps                     {}", b.steps);

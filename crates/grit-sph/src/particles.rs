@@ -83,6 +83,31 @@ impl Particles {
         retain_by(&mut self.local, keep);
     }
 
+    /// The particles in the order `order` gives: particle k of the result is `order[k]` here.
+    pub fn permuted(&self, order: &[usize]) -> Particles {
+        fn take<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
+            order.iter().map(|&i| v[i]).collect()
+        }
+        Particles {
+            id: take(&self.id, order),
+            body: take(&self.body, order),
+            flags: take(&self.flags, order),
+            pos: take(&self.pos, order),
+            vel: take(&self.vel, order),
+            mass: take(&self.mass, order),
+            rho: take(&self.rho, order),
+            rho0: take(&self.rho0, order),
+            sdev: take(&self.sdev, order),
+            eps_p: take(&self.eps_p, order),
+            eps_p_rate: take(&self.eps_p_rate, order),
+            temp: take(&self.temp, order),
+            damage: take(&self.damage, order),
+            def_grad: take(&self.def_grad, order),
+            x_ref: take(&self.x_ref, order),
+            local: take(&self.local, order),
+        }
+    }
+
     /// A copy of the particles with `keep[i]`, in order (a body's state, for a checkpoint).
     pub fn select(&self, keep: &[bool]) -> Particles {
         let mut out = self.clone();

@@ -51,6 +51,10 @@ pub struct Settings {
     /// interior particles of a rigid body are never searched, touched or summed, and its mass
     /// and inertia come from the polygon, so dropping them changes no result.
     pub rigid_shell: bool,
+    /// Deformable particles are re-sorted along a Z-order curve of neighbour cells at every
+    /// neighbour rebuild, so a particle's neighbours sit close to it in memory (issue 5, "model
+    /// no more"). Results change by rounding only: the sums run in another order.
+    pub cell_order: bool,
 }
 
 /// The largest Courant number `Settings` accepts.
@@ -73,6 +77,7 @@ impl Default for Settings {
             temperature_k: 293.0,
             contact_limits_dt: true,
             rigid_shell: false,
+            cell_order: false,
         }
     }
 }
@@ -800,6 +805,9 @@ impl World {
     /// Rebuilds neighbour lists: deformable particles see their own body and the primary
     /// boundary particles they can touch; rigid secondary boundary particles see their primaries.
     fn rebuild_neighbours(&mut self) {
+        if self.settings.cell_order {
+            self.sort_by_cell();
+        }
         let nb = self.bodies.len();
         // relation[a * nb + b]: can a particle of body a list one of body b?
         let mut relation = vec![false; nb * nb];
@@ -837,6 +845,41 @@ impl World {
         });
         self.x_build = p.pos.clone();
         self.nbrs_valid = true;
+    }
+
+    /// Reorders the particles by body, then deformable ones by the Z-order (Morton) index of
+    /// their neighbour-search cell, ties by current index; rigid bodies keep their order. Every
+    /// per-particle array moves with them (`Settings::cell_order`).
+    fn sort_by_cell(&mut self) {
+        let p = &self.particles;
+        let n = p.len();
+        if n == 0 {
+            return;
+        }
+        let cell = self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m;
+        let lo = p.pos.iter().fold(p.pos[0], |a, x| a.inf(x));
+        let deformable: Vec<bool> = self.bodies.iter().map(|b| !b.is_rigid()).collect();
+        let key = |i: usize| -> u64 {
+            if !deformable[p.body[i] as usize] {
+                return 0;
+            }
+            let c = (p.pos[i] - lo) / cell;
+            // Cells past 2^31 along an axis (a particle flung far off) share the last one.
+            let ix = c.x.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
+            let iy = c.y.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
+            morton(ix, iy)
+        };
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by_key(|&i| (p.body[i], key(i), i));
+        if order.iter().enumerate().all(|(k, &i)| k == i) {
+            return;
+        }
+        self.particles = p.permuted(&order);
+        for c in &mut self.contacts {
+            c.spring = order.iter().map(|&i| c.spring[i]).collect();
+            c.penetration = order.iter().map(|&i| c.penetration[i]).collect();
+        }
+        self.nbrs_valid = false;
     }
 
     fn needs_rebuild(&self) -> bool {
@@ -1651,6 +1694,20 @@ fn body_pairs<'a>(
             let (w, dw) = k.w_dw(r);
             Some(Pair { j, xij, r, w, dw })
         })
+}
+
+/// Interleaves the bits of `x` and `y` (x in the even bits): the Z-order curve index of a cell.
+fn morton(x: u32, y: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
+        v
+    }
+    spread(x) | (spread(y) << 1)
 }
 
 /// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a
