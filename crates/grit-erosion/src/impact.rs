@@ -3,8 +3,9 @@
 //! surface has settled.
 
 use grit_sph::{
-    cfl_matched_stiffness, contact::ContactModel, particles::KINEMATIC, ContactParams, InputError,
-    KernelKind, Material, Motion, Particles, Polygon, Settings, SimError, Timers, Vector, World,
+    cfl_matched_stiffness, contact::ContactModel, particles::KINEMATIC, Absorber, ContactParams,
+    InputError, KernelKind, Material, Motion, Particles, Polygon, Settings, SimError, Timers,
+    Vector, World,
 };
 use serde::{Deserialize, Serialize};
 
@@ -69,6 +70,9 @@ pub struct Numerics {
     /// Keep the surface's particles in Z-order of neighbour cells (`Settings::cell_order`;
     /// issue 5, "model no more"): results differ by rounding only.
     pub cell_order: bool,
+    /// Thickness, in particle layers, of an absorbing (sponge) layer just inside the surface's
+    /// fixed bottom and side bands; 0 for none (`grit_sph::Absorber`; issue 5, "model no more").
+    pub absorbing_layers: f64,
 }
 
 impl Default for Numerics {
@@ -85,6 +89,7 @@ impl Default for Numerics {
             grain_shell: true,
             skip_flight: true,
             cell_order: s.cell_order,
+            absorbing_layers: 0.0,
         }
     }
 }
@@ -112,6 +117,9 @@ impl Default for ImpactParams {
 /// Layers of fixed particles at the bottom and the sides of the surface: at least the kernel
 /// support (3h = 3.9 Δx), so free particles never see a truncated kernel there.
 const FIXED_LAYERS: f64 = 4.0;
+
+/// Continuum reflection of a normally incident wave the absorbing layer is tuned for.
+const ABSORBER_REFLECTION: f64 = 0.01;
 /// Fewest particle layers a surface may have: fixed layers below, free layers between, and as
 /// many again for the impact to work in.
 pub const MIN_SURFACE_LAYERS: f64 = 3.0 * FIXED_LAYERS;
@@ -185,13 +193,22 @@ impl ImpactParams {
                 ),
             ));
         }
+        let a = self.numerics.absorbing_layers;
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(InputError::new(
+                "numerics.absorbing_layers",
+                format!("must be >= 0, got {a}"),
+            ));
+        }
         let layers = self.surface_depth_dg * self.grain_diameter_m / self.spacing_m;
-        if layers < MIN_SURFACE_LAYERS {
+        if layers < MIN_SURFACE_LAYERS + a {
             return Err(InputError::new(
                 "surface_depth_dg",
                 format!(
-                    "gives {layers:.1} particle layers; at least {} are needed",
-                    MIN_SURFACE_LAYERS
+                    "gives {layers:.1} particle layers; at least {} are needed, {} of them for \
+                     numerics.absorbing_layers",
+                    MIN_SURFACE_LAYERS + a,
+                    a
                 ),
             ));
         }
@@ -235,17 +252,44 @@ impl ImpactParams {
         }
     }
 
+    /// Half-width and depth of the surface rectangle (m): whole numbers of spacings, so the
+    /// lattice fills it exactly.
+    fn surface_extent(&self) -> (f64, f64) {
+        let dx = self.spacing_m;
+        let nx = (self.surface_width_dg * self.grain_diameter_m / dx).round();
+        let ny = (self.surface_depth_dg * self.grain_diameter_m / dx).round();
+        (0.5 * nx * dx, ny * dx)
+    }
+
+    /// The absorbing layer of `numerics.absorbing_layers`, just inside the fixed bands, tuned
+    /// to reflect 1 % of a normally incident wave in the continuum; None when 0.
+    pub fn absorber(&self) -> Option<Absorber> {
+        let layers = self.numerics.absorbing_layers;
+        if layers <= 0.0 {
+            return None;
+        }
+        let (hw, depth) = self.surface_extent();
+        let inset = (FIXED_LAYERS + layers) * self.spacing_m;
+        let thickness_m = layers * self.spacing_m;
+        Some(Absorber {
+            inner_lo: Vector::new(-hw + inset, -depth + inset),
+            // The top is free: the box reaches far above it.
+            inner_hi: Vector::new(hw - inset, depth),
+            thickness_m,
+            sigma_max_per_s: Absorber::sigma_for(
+                self.material.sound_speed(),
+                thickness_m,
+                ABSORBER_REFLECTION,
+            ),
+        })
+    }
+
     /// The fresh surface: a lattice rectangle, top at y = 0, centred on x = 0, its bottom and
     /// side layers fixed (kinematic) so it needs no other support.
     pub fn fresh_surface(&self) -> Result<Particles, InputError> {
         self.validate()?;
         let dx = self.spacing_m;
-        let w = self.surface_width_dg * self.grain_diameter_m;
-        let d = self.surface_depth_dg * self.grain_diameter_m;
-        // Whole numbers of cells, so the lattice fills the rectangle exactly.
-        let nx = (w / dx).round();
-        let ny = (d / dx).round();
-        let (hw, depth) = (0.5 * nx * dx, ny * dx);
+        let (hw, depth) = self.surface_extent();
         let rect = Polygon::rectangle(-hw, -depth, hw, 0.0);
         let mut world = World::new(self.settings())?;
         let b = world.add_deformable_polygon(
@@ -406,6 +450,9 @@ pub fn impact_world(
     state.vel.iter_mut().for_each(|v| *v = Vector::zeros());
     let s = world.add_deformable_state("surface", params.material.clone(), state, Motion::Fixed)?;
     world.reset_temperature();
+    if let Some(a) = params.absorber() {
+        world.set_absorber(s, a)?;
+    }
     let g = world.add_rigid(
         "grain",
         &grain.polygon,

@@ -26,22 +26,33 @@ pub enum Variant {
     /// The seed's numerics with the grain's approach flight simulated step by step, as before
     /// the flight skip (`Numerics::skip_flight`) became the default.
     FullFlight,
+    /// The seed's numerics with an absorbing layer of this many particle layers inside the
+    /// surface's fixed bands (`Numerics::absorbing_layers`).
+    Absorbing(f64),
 }
 
 impl Variant {
-    /// Parses `seed`, `wendland_c2`, `full_flight` or `cfl=X`.
+    /// Parses `seed`, `wendland_c2`, `full_flight`, `cfl=X` or `absorbing=N`.
     pub fn parse(s: &str) -> Result<Variant, String> {
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
             "full_flight" => Ok(Variant::FullFlight),
+            other if other.starts_with("absorbing=") => {
+                match other["absorbing=".len()..].parse::<f64>() {
+                    Ok(n) if n.is_finite() && n > 0.0 => Ok(Variant::Absorbing(n)),
+                    _ => Err(format!(
+                        "--variants: `{other}`: the absorbing layer needs a number of layers > 0"
+                    )),
+                }
+            }
             other => match other.strip_prefix("cfl=").map(str::parse::<f64>) {
                 Some(Ok(c)) if c > 0.0 && c <= grit_sph::world::MAX_CFL => Ok(Variant::Cfl(c)),
                 Some(_) => Err(format!(
                     "--variants: `{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => Err(format!(
-                    "--variants: unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X)"
+                    "--variants: unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X, absorbing=N)"
                 )),
             },
         }
@@ -54,6 +65,7 @@ impl Variant {
             Variant::WendlandC2 => "Wendland C2".into(),
             Variant::Cfl(c) => format!("CFL {c}"),
             Variant::FullFlight => "seed, flight simulated".into(),
+            Variant::Absorbing(n) => format!("seed, absorbing layer of {n} Δx"),
         }
     }
 
@@ -69,6 +81,10 @@ impl Variant {
             Variant::Cfl(cfl) => Numerics { cfl, ..base },
             Variant::FullFlight => Numerics {
                 skip_flight: false,
+                ..base
+            },
+            Variant::Absorbing(absorbing_layers) => Numerics {
+                absorbing_layers,
                 ..base
             },
         }
@@ -293,6 +309,10 @@ mod tests {
         assert_eq!(Variant::parse("wendland_c2"), Ok(Variant::WendlandC2));
         assert_eq!(Variant::parse("cfl=0.5"), Ok(Variant::Cfl(0.5)));
         assert!(Variant::parse("cfl=3").unwrap_err().contains("(0, 2]"));
+        assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
+        assert!(Variant::parse("absorbing=-1")
+            .unwrap_err()
+            .contains("number of layers > 0"));
         assert!(Variant::parse("cubic")
             .unwrap_err()
             .contains("unknown variant `cubic`"));

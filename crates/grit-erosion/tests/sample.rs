@@ -148,6 +148,27 @@ fn bad_scene_names_the_field() {
             },
             "friction",
         ),
+        (
+            ImpactParams {
+                numerics: grit_erosion::Numerics {
+                    absorbing_layers: -1.0,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            "numerics.absorbing_layers",
+        ),
+        (
+            // 1.5 Dg at 8 µm is 46.9 layers: 12 for the scene, so 35 absorbing ones are too many.
+            ImpactParams {
+                numerics: grit_erosion::Numerics {
+                    absorbing_layers: 35.0,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            "surface_depth_dg",
+        ),
     ];
     for (p, field) in cases {
         let e = p.validate().unwrap_err();

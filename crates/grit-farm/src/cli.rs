@@ -305,7 +305,7 @@ enum BenchWhat {
         /// Resolutions, particles per grain diameter, comma-separated.
         #[arg(long, value_delimiter = ',', default_values_t = vec![8.0, 12.0, 16.0, 24.0, 32.0])]
         ppd: Vec<f64>,
-        /// Numerical variants (seed, wendland_c2, full_flight, cfl=X), comma-separated; the
+        /// Numerical variants (seed, wendland_c2, full_flight, cfl=X, absorbing=N), comma-separated; the
         /// first is the reference.
         #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
         variants: Vec<String>,

@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::body::{Body, BodyKind, ExternalForce, Motion, Rigid};
+use crate::body::{Absorber, Body, BodyKind, ExternalForce, Motion, Rigid};
 use crate::contact::{self, ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::geometry::Polygon;
@@ -167,6 +167,9 @@ pub struct NumericalWork {
     pub contact_damping: f64,
     /// Plastic work (heat and stored work of plasticity).
     pub plastic: f64,
+    /// Work of the absorbing layers (`Absorber`).
+    #[serde(default)]
+    pub absorbed: f64,
 }
 
 /// Smallest number of particles one rayon task takes: below it the per-task overhead costs more
@@ -411,6 +414,7 @@ impl World {
             kind: BodyKind::Deformable {
                 material,
                 boundary_motion: Motion::Fixed,
+                absorber: None,
             },
             removed_mass_kg_m: 0.0,
             removed_particles: 0,
@@ -475,6 +479,7 @@ impl World {
             kind: BodyKind::Deformable {
                 material,
                 boundary_motion,
+                absorber: None,
             },
             removed_mass_kg_m: 0.0,
             removed_particles: 0,
@@ -530,6 +535,40 @@ impl World {
             }
         }
         Ok(n)
+    }
+
+    /// Gives deformable body `b` an absorbing layer (a sponge along its edges, `Absorber`).
+    pub fn set_absorber(&mut self, b: usize, layer: Absorber) -> Result<(), InputError> {
+        InputError::require_positive("absorber.thickness_m", layer.thickness_m)?;
+        if !(layer.sigma_max_per_s.is_finite() && layer.sigma_max_per_s >= 0.0) {
+            return Err(InputError::new(
+                "absorber.sigma_max_per_s",
+                format!(
+                    "must be a finite number >= 0, got {}",
+                    layer.sigma_max_per_s
+                ),
+            ));
+        }
+        let corners = [layer.inner_lo, layer.inner_hi];
+        if !corners.iter().all(|c| c.x.is_finite() && c.y.is_finite())
+            || layer.inner_lo.x > layer.inner_hi.x
+            || layer.inner_lo.y > layer.inner_hi.y
+        {
+            return Err(InputError::new(
+                "absorber.inner_lo",
+                "the undamped box needs finite corners with inner_lo below and left of inner_hi",
+            ));
+        }
+        match self.bodies.get_mut(b).map(|body| &mut body.kind) {
+            Some(BodyKind::Deformable { absorber, .. }) => {
+                *absorber = Some(layer);
+                Ok(())
+            }
+            _ => Err(InputError::new(
+                "absorber",
+                "only deformable bodies take an absorbing layer",
+            )),
+        }
     }
 
     /// Adds a rigid polygon of `density_kg_m3` (mass and inertia from the polygon itself),
@@ -1472,11 +1511,19 @@ impl World {
                 _ => None,
             })
             .collect();
+        let absorbers: Vec<Option<Absorber>> = self
+            .bodies
+            .iter()
+            .map(|b| match &b.kind {
+                BodyKind::Deformable { absorber, .. } => *absorber,
+                _ => None,
+            })
+            .collect();
         let h = self.kernel.h;
         let acc = &self.scratch.acc;
         let cf = &self.scratch.contact_force;
         let p = &mut self.particles;
-        let bad: Option<(usize, String)> = p
+        let out: Vec<(Option<String>, f64)> = p
             .pos
             .par_iter_mut()
             .zip(p.vel.par_iter_mut())
@@ -1486,35 +1533,54 @@ impl World {
             .map(|(i, (x, v))| {
                 let b = p.body[i] as usize;
                 if !bc[b].deformable {
-                    return None;
+                    return (None, 0.0);
                 }
+                let mut absorbed = 0.0;
                 if p.flags[i] & KINEMATIC != 0 {
                     *v = motions[b].unwrap_or_else(Vector::zeros);
                 } else {
-                    *v += (acc[i] + cf[i] / p.mass[i]) * dt;
+                    let free = *v + (acc[i] + cf[i] / p.mass[i]) * dt;
+                    // Implicit in the damping, so any σ dt is stable.
+                    let sigma = absorbers[b].map_or(0.0, |a| a.sigma(*x));
+                    *v = free / (1.0 + sigma * dt);
+                    // The work of the damping force −mσv over the step's displacement v dt.
+                    absorbed = -p.mass[i] * sigma * v.norm_squared() * dt;
                 }
                 let dxs = *v * dt;
                 *x += dxs;
                 if !(x.x.is_finite() && x.y.is_finite() && v.x.is_finite() && v.y.is_finite()) {
-                    return Some((i, "position or velocity is not finite".to_string()));
+                    return (
+                        Some("position or velocity is not finite".to_string()),
+                        absorbed,
+                    );
                 }
                 if !(p.sdev[i].iter().all(|s| s.is_finite()) && p.rho[i].is_finite()) {
-                    return Some((i, "stress or density is not finite".to_string()));
+                    return (
+                        Some("stress or density is not finite".to_string()),
+                        absorbed,
+                    );
                 }
                 if p.rho[i] <= 0.0 {
-                    return Some((i, format!("density {:.4e} kg/m³ is not positive", p.rho[i])));
+                    let what = format!("density {:.4e} kg/m³ is not positive", p.rho[i]);
+                    return (Some(what), absorbed);
                 }
                 let step = dxs.norm();
                 if step > h {
-                    return Some((
-                        i,
-                        format!("moved {step:.3e} m in one step, more than h = {h:.3e} m"),
-                    ));
+                    let what = format!("moved {step:.3e} m in one step, more than h = {h:.3e} m");
+                    return (Some(what), absorbed);
                 }
-                None
+                (None, absorbed)
             })
-            .find_first(|b| b.is_some())
-            .flatten();
+            .collect();
+        // Serial, in particle order: the first failure and the absorbed work do not depend on
+        // the thread count.
+        let mut bad = None;
+        for (i, (what, w)) in out.into_iter().enumerate() {
+            self.work.absorbed += w;
+            if bad.is_none() {
+                bad = what.map(|w| (i, w));
+            }
+        }
         if let Some((i, what)) = bad {
             let p = &self.particles;
             return Err(SimError {
