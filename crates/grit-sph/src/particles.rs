@@ -65,54 +65,34 @@ impl Particles {
 
     /// Keeps the particles with `keep[i]`, preserving order (so loop order stays deterministic).
     pub fn retain(&mut self, keep: &[bool]) {
-        retain_by(&mut self.id, keep);
-        retain_by(&mut self.body, keep);
-        retain_by(&mut self.flags, keep);
-        retain_by(&mut self.pos, keep);
-        retain_by(&mut self.vel, keep);
-        retain_by(&mut self.mass, keep);
-        retain_by(&mut self.rho, keep);
-        retain_by(&mut self.rho0, keep);
-        retain_by(&mut self.sdev, keep);
-        retain_by(&mut self.eps_p, keep);
-        retain_by(&mut self.eps_p_rate, keep);
-        retain_by(&mut self.temp, keep);
-        retain_by(&mut self.damage, keep);
-        retain_by(&mut self.def_grad, keep);
-        retain_by(&mut self.x_ref, keep);
-        retain_by(&mut self.local, keep);
+        *self = self.permuted(&kept(keep));
     }
 
     /// The particles in the order `order` gives: particle k of the result is `order[k]` here.
     pub fn permuted(&self, order: &[usize]) -> Particles {
-        fn take<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
-            order.iter().map(|&i| v[i]).collect()
-        }
         Particles {
-            id: take(&self.id, order),
-            body: take(&self.body, order),
-            flags: take(&self.flags, order),
-            pos: take(&self.pos, order),
-            vel: take(&self.vel, order),
-            mass: take(&self.mass, order),
-            rho: take(&self.rho, order),
-            rho0: take(&self.rho0, order),
-            sdev: take(&self.sdev, order),
-            eps_p: take(&self.eps_p, order),
-            eps_p_rate: take(&self.eps_p_rate, order),
-            temp: take(&self.temp, order),
-            damage: take(&self.damage, order),
-            def_grad: take(&self.def_grad, order),
-            x_ref: take(&self.x_ref, order),
-            local: take(&self.local, order),
+            id: gather(&self.id, order),
+            body: gather(&self.body, order),
+            flags: gather(&self.flags, order),
+            pos: gather(&self.pos, order),
+            vel: gather(&self.vel, order),
+            mass: gather(&self.mass, order),
+            rho: gather(&self.rho, order),
+            rho0: gather(&self.rho0, order),
+            sdev: gather(&self.sdev, order),
+            eps_p: gather(&self.eps_p, order),
+            eps_p_rate: gather(&self.eps_p_rate, order),
+            temp: gather(&self.temp, order),
+            damage: gather(&self.damage, order),
+            def_grad: gather(&self.def_grad, order),
+            x_ref: gather(&self.x_ref, order),
+            local: gather(&self.local, order),
         }
     }
 
     /// A copy of the particles with `keep[i]`, in order (a body's state, for a checkpoint).
     pub fn select(&self, keep: &[bool]) -> Particles {
-        let mut out = self.clone();
-        out.retain(keep);
-        out
+        self.permuted(&kept(keep))
     }
 
     /// Appends `other`'s particles after these, unchanged.
@@ -173,14 +153,16 @@ pub fn dev_contract(s: &Matrix) -> f64 {
     s[(0, 0)] * s[(0, 0)] + s[(1, 1)] * s[(1, 1)] + szz * szz + 2.0 * s[(0, 1)] * s[(0, 1)]
 }
 
-/// Keeps `v[i]` where `keep[i]`, in order: the one compaction every per-particle array uses.
-pub fn retain_by<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
-    let mut k = 0;
-    for (i, &kp) in keep.iter().enumerate().take(v.len()) {
-        if kp {
-            v[k] = v[i];
-            k += 1;
-        }
-    }
-    v.truncate(k);
+/// The indices i with `keep[i]`, in order: the gather order that keeps those particles.
+pub fn kept(keep: &[bool]) -> Vec<usize> {
+    keep.iter()
+        .enumerate()
+        .filter_map(|(i, &k)| k.then_some(i))
+        .collect()
+}
+
+/// `v[order[k]]` for every k: the one reordering every per-particle array goes through
+/// (deletion keeps a subset in order, the cell sort permutes).
+pub fn gather<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
+    order.iter().map(|&i| v[i]).collect()
 }

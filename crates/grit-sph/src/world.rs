@@ -176,11 +176,11 @@ pub struct NumericalWork {
 /// than the work (small verification scenes ran slower on 2 threads than on 1 without it).
 const MIN_LEN: usize = 64;
 
-/// Largest number of particles one rayon task takes. Rayon's adaptive splitting stopped at
-/// quarters of a loop, and the work of a step is uneven along the index (the grain's particles
-/// and the free surface do less, the few hundred particles under the grain do the contact), so
-/// one thread sat idle while the other finished its quarter. Tasks of at most 256 particles let
-/// the idle thread steal: the full step's speed-up from 1 to 2 threads rose from 1.66 to 1.86
+/// Largest number of particles one rayon task takes. The work of a step is uneven along the
+/// index (the grain's particles and the free surface do less, the few hundred particles under
+/// the grain do the contact), and rayon's adaptive splitting can leave a few large tasks, so one
+/// thread sat idle while the other finished. Tasks of at most 256 particles let the idle thread
+/// steal: the full step's speed-up from 1 to 2 threads rose from 1.66 to 1.86
 /// (median of 4–5, `cargo run --release -p grit-erosion --example stage_scaling`).
 const MAX_LEN: usize = 256;
 
@@ -820,12 +820,19 @@ impl World {
     }
 
     fn retain_particles(&mut self, keep: &[bool]) {
-        self.particles.retain(keep);
-        for c in &mut self.contacts {
-            crate::particles::retain_by(&mut c.spring, keep);
-            crate::particles::retain_by(&mut c.penetration, keep);
-        }
+        self.reorder_particles(&crate::particles::kept(keep));
         self.refresh_contact_masses();
+    }
+
+    /// Puts particle `order[k]` at index k, dropping those not listed: every per-particle array
+    /// and the contact springs move together, and the neighbour lists are stale.
+    fn reorder_particles(&mut self, order: &[usize]) {
+        use crate::particles::gather;
+        self.particles = self.particles.permuted(order);
+        for c in &mut self.contacts {
+            c.spring = gather(&c.spring, order);
+            c.penetration = gather(&c.penetration, order);
+        }
         self.nbrs_valid = false;
     }
 
@@ -913,12 +920,7 @@ impl World {
         if order.iter().enumerate().all(|(k, &i)| k == i) {
             return;
         }
-        self.particles = p.permuted(&order);
-        for c in &mut self.contacts {
-            c.spring = order.iter().map(|&i| c.spring[i]).collect();
-            c.penetration = order.iter().map(|&i| c.penetration[i]).collect();
-        }
-        self.nbrs_valid = false;
+        self.reorder_particles(&order);
     }
 
     fn needs_rebuild(&self) -> bool {
