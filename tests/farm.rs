@@ -7,7 +7,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use grit_erosion::ImpactRecord;
-use grit_farm::api::CampaignState;
+use grit_farm::api::{CampaignState, CampaignStatus};
 use grit_farm::{Client, Secret};
 use serde_json::Value;
 use uuid::Uuid;
@@ -44,6 +44,13 @@ fn submitter(url: &str) -> Client {
 
 fn worker_client(url: &str) -> Client {
     Client::new(url, Secret::new(Some(WORKER.into()))).unwrap()
+}
+
+/// Waits up to `limit` for the campaign to finish, which it must do as `done`.
+async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
+    let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
+    assert_eq!(s.state, CampaignState::Done);
+    s
 }
 
 fn raw_series(results: &Value) -> Vec<(u64, u64, Vec<ImpactRecord>)> {
@@ -132,14 +139,7 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     let _w1 = worker(dir.path(), &coord.url, "w1");
     let _w2 = worker(dir.path(), &coord.url, "w2");
     let c = submitter(&coord.url);
-    let s = wait_for(
-        Duration::from_secs(120),
-        "done",
-        || c.status(id),
-        |s| s.state.is_final(),
-    )
-    .await;
-    assert_eq!(s.state, CampaignState::Done);
+    let s = wait_done(&c, id, Duration::from_secs(120)).await;
     assert_eq!(s.impacts_done, s.impacts_total);
     assert_eq!(s.impacts_total, 4);
     let farm = c.results_value(id, false).await.unwrap();
@@ -173,14 +173,7 @@ async fn killed_worker_is_resumed_from_checkpoint_bit_for_bit() {
         "the job must still be running when killed"
     );
     let w2 = worker(dir.path(), &coord.url, "w2");
-    let s = wait_for(
-        Duration::from_secs(120),
-        "done",
-        || c.status(id),
-        |s| s.state.is_final(),
-    )
-    .await;
-    assert_eq!(s.state, CampaignState::Done);
+    let s = wait_done(&c, id, Duration::from_secs(120)).await;
     assert!(
         w2.log_text().contains("resumed from checkpoint"),
         "the second worker resumes from the checkpoint:\n{}",
@@ -218,14 +211,7 @@ async fn coordinator_restart_loses_nothing() {
         after.impacts_done >= mid.impacts_done,
         "nothing stored was lost"
     );
-    let s = wait_for(
-        Duration::from_secs(180),
-        "done",
-        || c.status(id),
-        |s| s.state.is_final(),
-    )
-    .await;
-    assert_eq!(s.state, CampaignState::Done);
+    let s = wait_done(&c, id, Duration::from_secs(180)).await;
     assert_eq!(s.impacts_done, 8);
     let farm = raw_series(&c.results_value(id, true).await.unwrap());
     for (_, _, records) in &farm {

@@ -175,16 +175,7 @@ impl Store {
                 ),
             ));
         }
-        sqlx::query(
-            "UPDATE jobs SET state = 'done', impacts_done = ?, lease_id = NULL,
-                             lease_expires_ms = NULL, updated_ms = ?
-             WHERE id = ?",
-        )
-        .bind(done as i64)
-        .bind(now)
-        .bind(job_id)
-        .execute(&mut *tx)
-        .await?;
+        end_lease(&mut tx, job_id, "done", done, now).await?;
         sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
             .bind(job_id)
             .execute(&mut *tx)
@@ -236,16 +227,7 @@ impl Store {
         let Report {
             mut tx, now, done, ..
         } = self.report(job_id, lease, impacts, checkpoint).await?;
-        sqlx::query(
-            "UPDATE jobs SET state = 'queued', impacts_done = ?, lease_id = NULL, worker = NULL,
-                             lease_expires_ms = NULL, updated_ms = ?
-             WHERE id = ?",
-        )
-        .bind(done as i64)
-        .bind(now)
-        .bind(job_id)
-        .execute(&mut *tx)
-        .await?;
+        end_lease(&mut tx, job_id, "queued", done, now).await?;
         tx.commit().await?;
         tracing::info!(job = job_id, impacts = done, "job released");
         Ok(())
@@ -317,6 +299,29 @@ async fn check_lease(
         planned: r.get::<i64, _>("impacts_planned") as u32,
         done: r.get::<i64, _>("impacts_done") as u32,
     })
+}
+
+/// Ends the lease on `job_id`: its state becomes `state` with `done` impacts stored at `now`.
+/// A done job keeps its worker, as the one that finished it; a requeued one holds none.
+async fn end_lease(
+    tx: &mut Transaction<'static, Sqlite>,
+    job_id: i64,
+    state: &str,
+    done: u32,
+    now: i64,
+) -> Result<()> {
+    sqlx::query(
+        "UPDATE jobs SET state = ?1, impacts_done = ?2, lease_id = NULL, lease_expires_ms = NULL,
+                         worker = CASE WHEN ?1 = 'done' THEN worker END, updated_ms = ?3
+         WHERE id = ?4",
+    )
+    .bind(state)
+    .bind(done as i64)
+    .bind(now)
+    .bind(job_id)
+    .execute(&mut **tx)
+    .await?;
+    Ok(())
 }
 
 /// Marks the worker holding `job_id` as seen at `now`; called by every write of a lease
