@@ -173,7 +173,7 @@ async fn killed_worker_is_resumed_from_checkpoint_bit_for_bit() {
         "the job must still be running when killed"
     );
     let w2 = worker(dir.path(), &coord.url, "w2");
-    let s = wait_done(&c, id, Duration::from_secs(120)).await;
+    wait_done(&c, id, Duration::from_secs(120)).await;
     assert!(
         w2.log_text().contains("resumed from checkpoint"),
         "the second worker resumes from the checkpoint:\n{}",
