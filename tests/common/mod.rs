@@ -154,6 +154,7 @@ pub struct Api {
 }
 
 impl Api {
+    /// A client of the coordinator at base URL `url`.
     pub fn new(url: &str) -> Api {
         Api {
             http: reqwest::Client::new(),
@@ -161,6 +162,7 @@ impl Api {
         }
     }
 
+    /// `GET path` under `/api/v1`, with `token` if given.
     pub async fn get(&self, path: &str, token: Option<&str>) -> (u16, Value) {
         let mut rb = self.http.get(format!("{}{path}", self.base));
         if let Some(t) = token {
@@ -171,6 +173,7 @@ impl Api {
         (status, r.json().await.unwrap_or(Value::Null))
     }
 
+    /// `POST path` under `/api/v1` with a JSON `body` and `token`.
     pub async fn post(&self, path: &str, token: &str, body: &Value) -> (u16, Value) {
         let r = self
             .http
