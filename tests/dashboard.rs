@@ -10,88 +10,23 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use serde_json::{json, Value};
+use serde_json::json;
 
 mod common;
-use common::{campaign, Proc, SERIAL, SUBMIT, WORKER};
+use common::{campaign, start_worker, wait_for, Api, Coordinator, SERIAL, SUBMIT, WORKER};
 
 const CHROMIUM: &str = "/usr/bin/chromium";
 
-/// `grit serve` on a free loopback port; returns the process and its base URL.
-fn start_coordinator(dir: &Path, max_attempts: u32) -> (Proc, String) {
+/// `grit serve` on a free loopback port, failing a job for good after `max_attempts`.
+fn start_coordinator(dir: &Path, max_attempts: u32) -> Coordinator {
     let attempts = max_attempts.to_string();
-    let args = [
-        "--listen",
+    common::start_coordinator(
+        dir,
+        "a",
         "127.0.0.1:0",
-        "--lease-ttl-s",
-        "30",
-        "--max-attempts",
-        &attempts,
-    ];
-    common::start_coordinator(dir, "a", &args)
-}
-
-fn start_worker(dir: &Path, url: &str, name: &str) -> Proc {
-    common::start_worker(dir, url, name, &[])
-}
-
-/// A small HTTP helper: JSON calls with a bearer token, answering (status, body).
-struct Api {
-    http: reqwest::Client,
-    base: String,
-}
-
-impl Api {
-    fn new(url: &str) -> Api {
-        Api {
-            http: reqwest::Client::new(),
-            base: format!("{url}/api/v1"),
-        }
-    }
-
-    async fn get(&self, path: &str, token: Option<&str>) -> (u16, Value) {
-        let mut rb = self.http.get(format!("{}{path}", self.base));
-        if let Some(t) = token {
-            rb = rb.bearer_auth(t);
-        }
-        let r = rb.send().await.unwrap();
-        let status = r.status().as_u16();
-        (status, r.json().await.unwrap_or(Value::Null))
-    }
-
-    async fn post(&self, path: &str, token: &str, body: &Value) -> (u16, Value) {
-        let r = self
-            .http
-            .post(format!("{}{path}", self.base))
-            .bearer_auth(token)
-            .json(body)
-            .send()
-            .await
-            .unwrap();
-        let status = r.status().as_u16();
-        (status, r.json().await.unwrap_or(Value::Null))
-    }
-
-    async fn submit(&self, spec: &str) -> String {
-        let r = self
-            .http
-            .post(format!("{}/campaigns", self.base))
-            .bearer_auth(SUBMIT)
-            .header("content-type", "application/json")
-            .body(spec.to_string())
-            .send()
-            .await
-            .unwrap();
-        assert_eq!(r.status().as_u16(), 201);
-        let body: Value = r.json().await.unwrap();
-        body["id"].as_str().unwrap().to_string()
-    }
-
-    async fn ok(&self, path: &str) -> Value {
-        let (status, body) = self.get(path, Some(SUBMIT)).await;
-        assert_eq!(status, 200, "GET {path}: {body}");
-        body
-    }
+        30.0,
+        &["--max-attempts", &attempts],
+    )
 }
 
 /// Claims the queued job as `worker` and reports a failure, as a worker whose engine stopped
@@ -173,32 +108,12 @@ fn run_chromium(dir: &Path, url: &str, extra: &[&str]) -> String {
     std::fs::read_to_string(&out).unwrap()
 }
 
-async fn wait_until(
-    api: &Api,
-    id: &str,
-    limit: Duration,
-    what: &str,
-    done: impl Fn(&Value) -> bool,
-) {
-    let start = Instant::now();
-    loop {
-        let st = api.ok(&format!("/campaigns/{id}")).await;
-        if done(&st) {
-            return;
-        }
-        assert!(
-            start.elapsed() < limit,
-            "timed out waiting for {what}: {st}"
-        );
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
-}
-
 #[tokio::test(flavor = "multi_thread")]
 async fn page_is_open_and_the_new_endpoints_list_workers_and_failed_jobs() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let (coord, url) = start_coordinator(dir.path(), 1);
+    let coord = start_coordinator(dir.path(), 1);
+    let url = coord.url.clone();
     let api = Api::new(&url);
     let http = reqwest::Client::new();
 
@@ -327,7 +242,7 @@ async fn page_is_open_and_the_new_endpoints_list_workers_and_failed_jobs() {
     assert!(doc["paths"]["/api/v1/workers"]["get"].is_object());
     assert!(doc["paths"]["/api/v1/campaigns/{id}/jobs"]["get"].is_object());
     assert!(doc["components"]["schemas"]["WorkersResponse"].is_object());
-    let log = coord.log_text();
+    let log = coord.proc.log_text();
     assert!(!log.contains(SUBMIT) && !log.contains(WORKER));
 }
 
@@ -336,7 +251,8 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
     let chromium_path = chromium();
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let (_coord, url) = start_coordinator(dir.path(), 1);
+    let coord = start_coordinator(dir.path(), 1);
+    let url = coord.url.clone();
     let api = Api::new(&url);
 
     // Two angles × two samples × 20 impacts: enough for each sample's last-20 slope, so the
@@ -344,7 +260,7 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
     let id = api
         .submit(&campaign("dashboard-e2e", "[45, 90]", 2, 20))
         .await;
-    let worker = start_worker(dir.path(), &url, "dash-worker");
+    let worker = start_worker(dir.path(), &url, "dash-worker", &[]);
     // While it runs, the worker is listed with the job it holds.
     let start = Instant::now();
     loop {
@@ -356,11 +272,10 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
         assert!(start.elapsed() < Duration::from_secs(60), "{w}");
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
-    wait_until(
-        &api,
-        &id,
+    wait_for(
         Duration::from_secs(900),
         "the campaign done",
+        || api.campaign(&id),
         |s| s["state"] == "done",
     )
     .await;
@@ -376,9 +291,12 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
         "impact 1: particle 42 moved more than h in one step",
     )
     .await;
-    wait_until(&api, &failing, Duration::from_secs(10), "failed", |s| {
-        s["state"] == "failed"
-    })
+    wait_for(
+        Duration::from_secs(10),
+        "failed",
+        || api.campaign(&failing),
+        |s| s["state"] == "failed",
+    )
     .await;
     let results = api.ok(&format!("/campaigns/{id}/results")).await;
     let with_erosion = results["cells"]

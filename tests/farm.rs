@@ -14,36 +14,28 @@ use uuid::Uuid;
 
 mod common;
 use common::{
-    campaign as spec_of, start_worker as spawn_worker, Proc, GRIT, SERIAL, SUBMIT, WORKER,
+    start_coordinator, start_worker, wait_for, Coordinator, GRIT, SERIAL, SUBMIT, WORKER,
 };
 
 /// The coarsest real scene at 60°.
 fn campaign(samples: u32, impacts: u32) -> String {
-    spec_of("e2e", "[60]", samples, impacts)
+    common::campaign("e2e", "[60]", samples, impacts)
 }
 
-struct Coordinator {
-    proc: Proc,
-    url: String,
-}
-
-fn start_coordinator(dir: &Path, listen: &str, lease_ttl_s: f64, tag: &str) -> Coordinator {
-    let ttl = lease_ttl_s.to_string();
-    let args = [
-        "--listen",
+/// `grit serve` with a lease of `lease_ttl_s` and a 64 KiB limit on specs.
+fn coordinator(dir: &Path, listen: &str, lease_ttl_s: f64, tag: &str) -> Coordinator {
+    start_coordinator(
+        dir,
+        tag,
         listen,
-        "--lease-ttl-s",
-        &ttl,
-        "--max-spec-bytes",
-        "65536",
-    ];
-    let (proc, url) = common::start_coordinator(dir, tag, &args);
-    Coordinator { proc, url }
+        lease_ttl_s,
+        &["--max-spec-bytes", "65536"],
+    )
 }
 
 /// A worker that checkpoints after every impact, so a kill loses at most one.
-fn start_worker(dir: &Path, url: &str, tag: &str) -> Proc {
-    spawn_worker(dir, url, tag, &["--checkpoint-every", "1"])
+fn worker(dir: &Path, url: &str, tag: &str) -> common::Proc {
+    start_worker(dir, url, tag, &["--checkpoint-every", "1"])
 }
 
 fn submitter(url: &str) -> Client {
@@ -54,29 +46,11 @@ fn worker_client(url: &str) -> Client {
     Client::new(url, Secret::new(Some(WORKER.into()))).unwrap()
 }
 
-/// Polls the campaign until `done` holds, failing after `limit`.
-async fn wait_for(
-    c: &Client,
-    id: Uuid,
-    limit: Duration,
-    what: &str,
-    done: impl Fn(&CampaignStatus) -> bool,
-) -> CampaignStatus {
-    let start = Instant::now();
-    loop {
-        if let Ok(s) = c.status(id).await {
-            if done(&s) {
-                return s;
-            }
-            assert!(
-                start.elapsed() < limit,
-                "timed out waiting for {what}; last status {s:?}"
-            );
-        } else {
-            assert!(start.elapsed() < limit, "timed out waiting for {what}");
-        }
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
+/// Waits up to `limit` for the campaign to finish, which it must do as `done`.
+async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
+    let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
+    assert_eq!(s.state, CampaignState::Done);
+    s
 }
 
 fn raw_series(results: &Value) -> Vec<(u64, u64, Vec<ImpactRecord>)> {
@@ -151,7 +125,7 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let spec = campaign(2, 2);
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
     let file = dir.path().join("spec.json");
     std::fs::write(&file, &spec).unwrap();
     let out = grit_cli(&coord.url, &["submit", file.to_str().unwrap()]);
@@ -162,14 +136,10 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     );
     let stdout = String::from_utf8(out.stdout).unwrap();
     let id: Uuid = stdout.lines().last().unwrap().trim().parse().unwrap();
-    let _w1 = start_worker(dir.path(), &coord.url, "w1");
-    let _w2 = start_worker(dir.path(), &coord.url, "w2");
+    let _w1 = worker(dir.path(), &coord.url, "w1");
+    let _w2 = worker(dir.path(), &coord.url, "w2");
     let c = submitter(&coord.url);
-    let s = wait_for(&c, id, Duration::from_secs(120), "done", |s| {
-        s.state.is_final()
-    })
-    .await;
-    assert_eq!(s.state, CampaignState::Done);
+    let s = wait_done(&c, id, Duration::from_secs(120)).await;
     assert_eq!(s.impacts_done, s.impacts_total);
     assert_eq!(s.impacts_total, 4);
     let farm = c.results_value(id, false).await.unwrap();
@@ -185,13 +155,16 @@ async fn killed_worker_is_resumed_from_checkpoint_bit_for_bit() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let spec = campaign(1, 6);
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 2.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 2.0, "a");
     let c = submitter(&coord.url);
     let id = c.submit(&spec, None).await.unwrap().id;
-    let mut w1 = start_worker(dir.path(), &coord.url, "w1");
-    wait_for(&c, id, Duration::from_secs(120), "2 impacts", |s| {
-        s.impacts_done >= 2
-    })
+    let mut w1 = worker(dir.path(), &coord.url, "w1");
+    wait_for(
+        Duration::from_secs(120),
+        "2 impacts",
+        || c.status(id),
+        |s| s.impacts_done >= 2,
+    )
     .await;
     w1.kill9();
     let before = c.status(id).await.unwrap();
@@ -199,12 +172,8 @@ async fn killed_worker_is_resumed_from_checkpoint_bit_for_bit() {
         before.impacts_done < 6,
         "the job must still be running when killed"
     );
-    let w2 = start_worker(dir.path(), &coord.url, "w2");
-    let s = wait_for(&c, id, Duration::from_secs(120), "done", |s| {
-        s.state.is_final()
-    })
-    .await;
-    assert_eq!(s.state, CampaignState::Done);
+    let w2 = worker(dir.path(), &coord.url, "w2");
+    wait_done(&c, id, Duration::from_secs(120)).await;
     assert!(
         w2.log_text().contains("resumed from checkpoint"),
         "the second worker resumes from the checkpoint:\n{}",
@@ -220,30 +189,29 @@ async fn coordinator_restart_loses_nothing() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let spec = campaign(2, 4);
-    let mut coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let mut coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
     let url = coord.url.clone();
     let c = submitter(&url);
     let id = c.submit(&spec, None).await.unwrap().id;
-    let w1 = start_worker(dir.path(), &url, "w1");
-    let w2 = start_worker(dir.path(), &url, "w2");
-    let mid = wait_for(&c, id, Duration::from_secs(120), "some impacts", |s| {
-        s.impacts_done >= 2
-    })
+    let w1 = worker(dir.path(), &url, "w1");
+    let w2 = worker(dir.path(), &url, "w2");
+    let mid = wait_for(
+        Duration::from_secs(120),
+        "some impacts",
+        || c.status(id),
+        |s| s.impacts_done >= 2,
+    )
     .await;
     coord.proc.kill9();
     tokio::time::sleep(Duration::from_secs(2)).await;
     let listen = url.trim_start_matches("http://").to_string();
-    let _coord2 = start_coordinator(dir.path(), &listen, 30.0, "b");
+    let _coord2 = coordinator(dir.path(), &listen, 30.0, "b");
     let after = c.status(id).await.unwrap();
     assert!(
         after.impacts_done >= mid.impacts_done,
         "nothing stored was lost"
     );
-    let s = wait_for(&c, id, Duration::from_secs(180), "done", |s| {
-        s.state.is_final()
-    })
-    .await;
-    assert_eq!(s.state, CampaignState::Done);
+    let s = wait_done(&c, id, Duration::from_secs(180)).await;
     assert_eq!(s.impacts_done, 8);
     let farm = raw_series(&c.results_value(id, true).await.unwrap());
     for (_, _, records) in &farm {
@@ -259,7 +227,7 @@ async fn coordinator_restart_loses_nothing() {
 async fn stale_worker_gets_409_and_changes_nothing() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 1.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 1.0, "a");
     let c = submitter(&coord.url);
     let id = c.submit(&campaign(1, 2), None).await.unwrap().id;
     let stale = worker_client(&coord.url);
@@ -305,7 +273,7 @@ async fn stale_worker_gets_409_and_changes_nothing() {
 async fn auth_validation_size_and_unknown_ids() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
     let http = reqwest::Client::new();
     let api = format!("{}/api/v1", coord.url);
     let status = |r: reqwest::Response| r.status().as_u16();
@@ -406,7 +374,7 @@ async fn auth_validation_size_and_unknown_ids() {
 async fn repeated_submit_with_idempotency_key_creates_one_campaign() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
     let c = submitter(&coord.url);
     let spec = campaign(1, 2);
     let first = c.submit(&spec, Some("key-1")).await.unwrap();
@@ -438,13 +406,16 @@ async fn repeated_submit_with_idempotency_key_creates_one_campaign() {
 async fn cancel_stops_handout_and_tells_running_workers() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 3.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 3.0, "a");
     let c = submitter(&coord.url);
     let id = c.submit(&campaign(3, 20), None).await.unwrap().id;
-    let mut w = start_worker(dir.path(), &coord.url, "w1");
-    wait_for(&c, id, Duration::from_secs(60), "a leased job", |s| {
-        s.jobs.leased >= 1
-    })
+    let mut w = worker(dir.path(), &coord.url, "w1");
+    wait_for(
+        Duration::from_secs(60),
+        "a leased job",
+        || c.status(id),
+        |s| s.jobs.leased >= 1,
+    )
     .await;
     let out = grit_cli(&coord.url, &["cancel", &id.to_string()]);
     assert!(
@@ -482,13 +453,16 @@ async fn cancel_stops_handout_and_tells_running_workers() {
 async fn sigterm_releases_the_job_with_a_checkpoint_and_exits_0() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let coord = start_coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
     let c = submitter(&coord.url);
     let id = c.submit(&campaign(1, 20), None).await.unwrap().id;
-    let mut w = start_worker(dir.path(), &coord.url, "w1");
-    wait_for(&c, id, Duration::from_secs(60), "an impact", |s| {
-        s.impacts_done >= 1
-    })
+    let mut w = worker(dir.path(), &coord.url, "w1");
+    wait_for(
+        Duration::from_secs(60),
+        "an impact",
+        || c.status(id),
+        |s| s.impacts_done >= 1,
+    )
     .await;
     let pid = w.child.id().to_string();
     assert!(Command::new("kill")

@@ -1,10 +1,15 @@
 //! Helpers the process-level tests share: the `grit` binary as coordinator and workers, each a
-//! child process killed on drop with its log in a file, and the coarsest real campaign.
+//! child process killed on drop with its log in a file; the coarsest real campaign; a JSON
+//! client of the API; and polling until a campaign gets somewhere.
 #![allow(dead_code)] // each test file uses its own subset
 
+use std::future::Future;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
 
 pub const GRIT: &str = env!("CARGO_BIN_EXE_grit");
 pub const SUBMIT: &str = "submit-token-for-tests";
@@ -51,15 +56,32 @@ impl Drop for Proc {
     }
 }
 
-/// `grit serve` on `dir/farm.db` with the test tokens and `args` (listen address, lease TTL,
-/// …), logging to `dir/coordinator-{tag}.log`; returns the process and the base URL it
-/// printed.
-pub fn start_coordinator(dir: &Path, tag: &str, args: &[&str]) -> (Proc, String) {
+/// A coordinator process and the base URL it printed.
+pub struct Coordinator {
+    pub proc: Proc,
+    pub url: String,
+}
+
+/// `grit serve` on `dir/farm.db` at `listen` with the test tokens, a lease of `lease_ttl_s`
+/// and `extra` flags, logging to `dir/coordinator-{tag}.log`.
+pub fn start_coordinator(
+    dir: &Path,
+    tag: &str,
+    listen: &str,
+    lease_ttl_s: f64,
+    extra: &[&str],
+) -> Coordinator {
     let log = dir.join(format!("coordinator-{tag}.log"));
     let mut child = Command::new(GRIT)
         .args(["serve", "--db"])
         .arg(dir.join("farm.db"))
-        .args(args)
+        .args([
+            "--listen",
+            listen,
+            "--lease-ttl-s",
+            &lease_ttl_s.to_string(),
+        ])
+        .args(extra)
         .env("GRIT_SUBMIT_TOKEN", SUBMIT)
         .env("GRIT_WORKER_TOKEN", WORKER)
         .env("RUST_LOG", "info")
@@ -78,7 +100,10 @@ pub fn start_coordinator(dir: &Path, tag: &str, args: &[&str]) -> (Proc, String)
         .filter(|u| u.starts_with("http://"))
         .unwrap_or_else(|| panic!("no address line from grit serve: {line:?}"))
         .to_string();
-    (Proc { child, log }, url)
+    Coordinator {
+        proc: Proc { child, log },
+        url,
+    }
 }
 
 /// `grit work` against `url` on one thread, named `name`, with `args` added, logging to
@@ -95,4 +120,101 @@ pub fn start_worker(dir: &Path, url: &str, name: &str, args: &[&str]) -> Proc {
         .spawn()
         .expect("grit work starts");
     Proc { child, log }
+}
+
+/// Polls `status` every 100 ms until `done` accepts its answer, which it returns; fails after
+/// `limit`. A failed poll is retried, so a coordinator may restart meanwhile.
+pub async fn wait_for<T: std::fmt::Debug, E, F: Future<Output = Result<T, E>>>(
+    limit: Duration,
+    what: &str,
+    mut status: impl FnMut() -> F,
+    done: impl Fn(&T) -> bool,
+) -> T {
+    let start = Instant::now();
+    loop {
+        if let Ok(s) = status().await {
+            if done(&s) {
+                return s;
+            }
+            assert!(
+                start.elapsed() < limit,
+                "timed out waiting for {what}; last status {s:?}"
+            );
+        } else {
+            assert!(start.elapsed() < limit, "timed out waiting for {what}");
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+}
+
+/// A small HTTP client of the API: JSON calls with a bearer token, answering (status, body).
+pub struct Api {
+    http: reqwest::Client,
+    base: String,
+}
+
+impl Api {
+    /// A client of the coordinator at base URL `url`.
+    pub fn new(url: &str) -> Api {
+        Api {
+            http: reqwest::Client::new(),
+            base: format!("{url}/api/v1"),
+        }
+    }
+
+    /// `GET path` under `/api/v1`, with `token` if given.
+    pub async fn get(&self, path: &str, token: Option<&str>) -> (u16, Value) {
+        let mut rb = self.http.get(format!("{}{path}", self.base));
+        if let Some(t) = token {
+            rb = rb.bearer_auth(t);
+        }
+        let r = rb.send().await.unwrap();
+        let status = r.status().as_u16();
+        (status, r.json().await.unwrap_or(Value::Null))
+    }
+
+    /// `POST path` under `/api/v1` with a JSON `body` and `token`.
+    pub async fn post(&self, path: &str, token: &str, body: &Value) -> (u16, Value) {
+        let r = self
+            .http
+            .post(format!("{}{path}", self.base))
+            .bearer_auth(token)
+            .json(body)
+            .send()
+            .await
+            .unwrap();
+        let status = r.status().as_u16();
+        (status, r.json().await.unwrap_or(Value::Null))
+    }
+
+    /// Submits `spec` with the submit token; returns the new campaign's id.
+    pub async fn submit(&self, spec: &str) -> String {
+        let r = self
+            .http
+            .post(format!("{}/campaigns", self.base))
+            .bearer_auth(SUBMIT)
+            .header("content-type", "application/json")
+            .body(spec.to_string())
+            .send()
+            .await
+            .unwrap();
+        assert_eq!(r.status().as_u16(), 201);
+        let body: Value = r.json().await.unwrap();
+        body["id"].as_str().unwrap().to_string()
+    }
+
+    /// A campaign's status with the submit token, or the HTTP status it was refused with.
+    pub async fn campaign(&self, id: &str) -> Result<Value, u16> {
+        match self.get(&format!("/campaigns/{id}"), Some(SUBMIT)).await {
+            (200, body) => Ok(body),
+            (status, _) => Err(status),
+        }
+    }
+
+    /// `GET path` with the submit token, which must answer 200.
+    pub async fn ok(&self, path: &str) -> Value {
+        let (status, body) = self.get(path, Some(SUBMIT)).await;
+        assert_eq!(status, 200, "GET {path}: {body}");
+        body
+    }
 }

@@ -3,8 +3,11 @@
 //! surface lost per g of grains (10⁻³ of the dimensionless erosion), so the slope of the
 //! mass-loss chart reads directly as erosion.
 
+use std::ops::Range;
+
 use grit_erosion::aggregate::cumulative_series;
 use grit_erosion::{CampaignResults, CellResult, Impact};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -53,6 +56,65 @@ where
         .label_font((FONT, 14))
         .draw()
         .map_err(de)
+}
+
+/// The axes every chart of this module draws on.
+type Axes<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Axes over `x` × `y` with the common caption size, margin and label areas.
+fn axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: impl AsRef<str>,
+    x: Range<f64>,
+    y: Range<f64>,
+) -> Result<Axes<'a, DB>, String> {
+    ChartBuilder::on(area)
+        .caption(caption, (FONT, 22))
+        .margin(15)
+        .x_label_area_size(55)
+        .y_label_area_size(85)
+        .build_cartesian_2d(x, y)
+        .map_err(de)
+}
+
+/// Axes of cumulative surface mass loss against cumulative grain mass, from 0.
+fn mass_axes<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: String,
+    xmax: f64,
+    ymax: f64,
+) -> Result<Axes<'_, DB>, String> {
+    let mut chart = axes(area, caption, 0.0..xmax, 0.0..ymax)?;
+    chart
+        .configure_mesh()
+        .x_desc("cumulative grain mass (g per m of depth)")
+        .y_desc("cumulative surface mass loss (mg per m of depth)")
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 17))
+        .draw()
+        .map_err(de)?;
+    Ok(chart)
+}
+
+/// Axes of a value (`y`, described by `y_desc`) against the impact angle, 0° to 95°.
+fn angle_axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    y: Range<f64>,
+    y_desc: &str,
+) -> Result<Axes<'a, DB>, String> {
+    let mut chart = axes(area, caption, 0.0..95.0, y)?;
+    chart
+        .configure_mesh()
+        .x_desc("impact angle α (degrees from the surface)")
+        .x_labels(20)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_desc(y_desc)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 17))
+        .draw()
+        .map_err(de)?;
+    Ok(chart)
 }
 
 fn line_key(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
@@ -115,28 +177,12 @@ impl Figure for MassLoss<'_> {
         let ymax = top(all()
             .map(|p| p.1)
             .chain(mean.iter().map(|p| p.1 + p.2.unwrap_or(0.0))));
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                format!(
-                    "Mass loss against grain mass: {} ({} samples)",
-                    cell_label(c),
-                    c.samples_reported
-                ),
-                (FONT, 22),
-            )
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(0.0..xmax, 0.0..ymax)
-            .map_err(de)?;
-        chart
-            .configure_mesh()
-            .x_desc("cumulative grain mass (g per m of depth)")
-            .y_desc("cumulative surface mass loss (mg per m of depth)")
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 17))
-            .draw()
-            .map_err(de)?;
+        let caption = format!(
+            "Mass loss against grain mass: {} ({} samples)",
+            cell_label(c),
+            c.samples_reported
+        );
+        let mut chart = mass_axes(&area, caption, xmax, ymax)?;
         if !self.samples.is_empty() {
             let faint = col.mix(0.45).stroke_width(1);
             for (k, s) in self.samples.iter().enumerate() {
@@ -288,27 +334,11 @@ impl Figure for SampleAngles {
         let all = || self.curves.iter().flat_map(|c| c.1.iter().copied());
         let xmax = top(all().map(|p| p.0));
         let ymax = top(all().map(|p| p.1));
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                format!(
-                    "Mass loss of one surface sample at each angle: {}, sample {}",
-                    self.label, self.sample
-                ),
-                (FONT, 22),
-            )
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(0.0..xmax, 0.0..ymax)
-            .map_err(de)?;
-        chart
-            .configure_mesh()
-            .x_desc("cumulative grain mass (g per m of depth)")
-            .y_desc("cumulative surface mass loss (mg per m of depth)")
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 17))
-            .draw()
-            .map_err(de)?;
+        let caption = format!(
+            "Mass loss of one surface sample at each angle: {}, sample {}",
+            self.label, self.sample
+        );
+        let mut chart = mass_axes(&area, caption, xmax, ymax)?;
         for (i, (angle, pts)) in self.curves.iter().enumerate() {
             let line = colour(i).stroke_width(2);
             chart
@@ -446,23 +476,12 @@ impl Figure for Angle<'_> {
         };
         let ymax = top(bars().chain(model()));
         let ymin = bottom(bars());
-        let mut chart = ChartBuilder::on(&area)
-            .caption("Erosion against impact angle, with Oka's model", (FONT, 22))
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(0.0..95.0, ymin..ymax)
-            .map_err(de)?;
-        chart
-            .configure_mesh()
-            .x_desc("impact angle α (degrees from the surface)")
-            .x_labels(20)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_desc(EROSION_AXIS)
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 17))
-            .draw()
-            .map_err(de)?;
+        let mut chart = angle_axes(
+            &area,
+            "Erosion against impact angle, with Oka's model",
+            ymin..ymax,
+            EROSION_AXIS,
+        )?;
         for (i, (s, (fit, published))) in self.an.series.iter().zip(&curves).enumerate() {
             let c = colour(i);
             let bar = c.stroke_width(1);
@@ -565,23 +584,12 @@ impl Figure for Normalised<'_> {
         };
         let ymax = top(values().chain(oka.iter().map(|p| p.1)));
         let ymin = bottom(values());
-        let mut chart = ChartBuilder::on(&area)
-            .caption("Erosion normalised by its value at 45°", (FONT, 22))
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(0.0..95.0, ymin..ymax)
-            .map_err(de)?;
-        chart
-            .configure_mesh()
-            .x_desc("impact angle α (degrees from the surface)")
-            .x_labels(20)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_desc("erosion / erosion at 45° (dimensionless)")
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 17))
-            .draw()
-            .map_err(de)?;
+        let mut chart = angle_axes(
+            &area,
+            "Erosion normalised by its value at 45°",
+            ymin..ymax,
+            "erosion / erosion at 45° (dimensionless)",
+        )?;
         let grey = BLACK.mix(0.6).stroke_width(2);
         chart
             .draw_series(DashedLineSeries::new(oka, 9, 5, grey))
@@ -685,26 +693,12 @@ impl Figure for ModifiedChart<'_> {
         };
         let ymax = top(points().chain(seeds.iter().chain(&fits).flatten().map(|p| p.1)));
         let ymin = bottom(points());
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                "Shape-modified Oka model (hexagon reference) against the simulation",
-                (FONT, 22),
-            )
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(0.0..95.0, ymin..ymax)
-            .map_err(de)?;
-        chart
-            .configure_mesh()
-            .x_desc("impact angle α (degrees from the surface)")
-            .x_labels(20)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_desc(EROSION_AXIS)
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 17))
-            .draw()
-            .map_err(de)?;
+        let mut chart = angle_axes(
+            &area,
+            "Shape-modified Oka model (hexagon reference) against the simulation",
+            ymin..ymax,
+            EROSION_AXIS,
+        )?;
         for (k, &i) in m.series.iter().enumerate() {
             let s = &self.an.series[i];
             let c = colour(i);
@@ -794,16 +788,12 @@ impl Figure for Convergence<'_> {
             .max()
             .unwrap_or(1);
         let (ymin, ymax) = (bottom(values()), top(values()));
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                "Convergence of erosion with the number of samples",
-                (FONT, 22),
-            )
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(85)
-            .build_cartesian_2d(0.5..(nmax as f64 + 0.5), ymin..ymax)
-            .map_err(de)?;
+        let mut chart = axes(
+            &area,
+            "Convergence of erosion with the number of samples",
+            0.5..(nmax as f64 + 0.5),
+            ymin..ymax,
+        )?;
         chart
             .configure_mesh()
             .x_desc("number of samples k (the first k with a slope)")

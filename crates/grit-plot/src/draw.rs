@@ -46,6 +46,16 @@ pub trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
 }
 
+/// Registers the fonts and creates `out` if missing, as every chart-writing entry point must
+/// before it draws.
+pub fn prepare_output(out: &Path) -> Result<(), PlotError> {
+    crate::register_fonts();
+    std::fs::create_dir_all(out).map_err(|error| PlotError::Output {
+        path: out.to_path_buf(),
+        error,
+    })
+}
+
 /// Draws `fig` as `out/stem.png` and `out/stem.svg`; returns both paths.
 pub fn save(fig: &impl Figure, out: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
     save_sized(fig, out, stem, SIZE)

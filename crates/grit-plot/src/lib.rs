@@ -73,11 +73,7 @@ pub struct Report {
 
 /// Writes every chart the results allow into `out` (created if missing), PNG and SVG each.
 pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
-    register_fonts();
-    std::fs::create_dir_all(out).map_err(|error| PlotError::Output {
-        path: out.to_path_buf(),
-        error,
-    })?;
+    draw::prepare_output(out)?;
     let analysis = analysis::Analysis::new(&input.results);
     let mut report = Report::default();
     charts::mass_loss(input, out, &mut report)?;

@@ -8,8 +8,8 @@ use grit_erosion::stability::{levels, spring_limit_cfl, Failure, Panel, Stabilit
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::draw::{de, save_sized, with_notes, DrawResult, Figure, FONT};
-use crate::{register_fonts, PlotError};
+use crate::draw::{de, prepare_output, save_sized, with_notes, DrawResult, Figure, FONT};
+use crate::PlotError;
 
 /// Size of the three-panel chart, pixels.
 const MAP_SIZE: (u32, u32) = (1650, 640);
@@ -164,7 +164,6 @@ pub fn stability_chart(
     stem: &str,
     notes: &[String],
 ) -> Result<Vec<PathBuf>, PlotError> {
-    register_fonts();
     if points.is_empty() {
         return Err(PlotError::Input("no stability points to draw".into()));
     }
@@ -180,9 +179,6 @@ pub fn stability_chart(
             .to_string(),
     ];
     all.extend(notes.iter().cloned());
-    std::fs::create_dir_all(out).map_err(|error| PlotError::Output {
-        path: out.to_path_buf(),
-        error,
-    })?;
+    prepare_output(out)?;
     save_sized(&Map { points, notes: all }, out, stem, MAP_SIZE)
 }

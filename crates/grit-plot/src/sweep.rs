@@ -9,8 +9,10 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::charts::legend_box;
-use crate::draw::{colour, de, error_bar, save_sized, with_notes, DrawResult, Figure, FONT};
-use crate::{register_fonts, PlotError};
+use crate::draw::{
+    colour, de, error_bar, prepare_output, save_sized, with_notes, DrawResult, Figure, FONT,
+};
+use crate::PlotError;
 
 /// Size of the two-panel chart, pixels.
 const SWEEP_SIZE: (u32, u32) = (1500, 700);
@@ -24,16 +26,28 @@ struct Sweep<'a> {
     notes: Vec<String>,
 }
 
-/// Dots of colour `c` at (x, y), each labelled with its resolution.
-fn labelled_dots<'a, DB: DrawingBackend + 'a, X, Y, L: std::fmt::Display>(
+/// A variant's line through `pts` (x, y, resolution) in colour `c`, named `label` in the
+/// legend with `key` as its mark, and its dots, each labelled with its resolution.
+fn variant_line<'a, DB: DrawingBackend + 'a, X, Y, L: std::fmt::Display, E>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     pts: &[(f64, f64, L)],
     c: RGBColor,
+    label: String,
+    key: impl Fn((i32, i32)) -> E + 'a,
 ) -> DrawResult
 where
     X: plotters::coord::ranged1d::Ranged<ValueType = f64>,
     Y: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+    E: IntoDynElement<'a, DB, (i32, i32)>,
 {
+    chart
+        .draw_series(LineSeries::new(
+            pts.iter().map(|p| (p.0, p.1)),
+            c.stroke_width(2),
+        ))
+        .map_err(de)?
+        .label(label)
+        .legend(key);
     let text = TextStyle::from((FONT, 14).into_font()).color(&c);
     chart
         .draw_series(pts.iter().map(|p| {
@@ -139,19 +153,11 @@ impl Sweep<'_> {
                     ))
                 })
                 .collect();
-            chart
-                .draw_series(LineSeries::new(
-                    pts.iter().map(|p| (p.0, p.1)),
-                    c.stroke_width(2),
-                ))
-                .map_err(de)?
-                .label(v.clone())
-                .legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (22, 0)], c.stroke_width(2))
-                        + Circle::new((11, 0), 4, c.filled())
-                });
-            labelled_dots(&mut chart, &pts, c)?;
+            variant_line(&mut chart, &pts, c, v.clone(), move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (22, 0)], c.stroke_width(2))
+                    + Circle::new((11, 0), 4, c.filled())
+            })?;
         }
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
@@ -206,17 +212,10 @@ impl Sweep<'_> {
                     ))
                 })
                 .collect();
-            chart
-                .draw_series(LineSeries::new(
-                    pts.iter().map(|p| (p.0, p.1)),
-                    c.stroke_width(2),
-                ))
-                .map_err(de)?
-                .label(format!("{v} (label: particles per radius)"))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(2))
-                });
-            labelled_dots(&mut chart, &pts, c)?;
+            let label = format!("{v} (label: particles per radius)");
+            variant_line(&mut chart, &pts, c, label, move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(2))
+            })?;
         }
         legend_box(&mut chart, SeriesLabelPosition::LowerLeft)
     }
@@ -238,7 +237,6 @@ pub fn sweep_chart(
     stem: &str,
     notes: &[String],
 ) -> Result<Vec<PathBuf>, PlotError> {
-    register_fonts();
     if rows.is_empty() {
         return Err(PlotError::Input("no sweep rows to draw".into()));
     }
@@ -254,10 +252,7 @@ pub fn sweep_chart(
             .to_string(),
     ];
     all.extend(notes.iter().cloned());
-    std::fs::create_dir_all(out).map_err(|error| PlotError::Output {
-        path: out.to_path_buf(),
-        error,
-    })?;
+    prepare_output(out)?;
     save_sized(
         &Sweep {
             rows,

@@ -1,0 +1,488 @@
+//! The store's side of the campaign endpoints: submitting (expanding a spec into cells and
+//! jobs), progress, results, the jobs list, cancel and retry.
+
+use std::collections::BTreeMap;
+
+use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::{aggregate_campaign, Impact, ImpactRecord, SampleInput};
+use sqlx::{QueryBuilder, Row, Sqlite};
+use uuid::Uuid;
+
+use super::{now_ms, parse_uuid, Store};
+use crate::api::{
+    CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress, JobCounts,
+    JobError, JobInfo, JobState, RawSample, ResultsResponse,
+};
+use crate::error::{Error, Result};
+
+/// Window over which the impact rate (and so the ETA) is measured.
+const RATE_WINDOW_MS: i64 = 120_000;
+
+impl Store {
+    /// Validates, expands and stores a campaign with all its jobs in one transaction. With an
+    /// idempotency key already used, returns the earlier campaign instead.
+    pub async fn create_campaign(
+        &self,
+        spec: &CampaignSpec,
+        idempotency_key: Option<&str>,
+    ) -> Result<CampaignCreated> {
+        let cells = spec.cells()?;
+        let impacts_total = spec.impacts_total()?;
+        let jobs_total = cells.len() as u64 * spec.samples as u64;
+        let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
+        let mut tx = self.begin().await?;
+        if let Some(key) = idempotency_key {
+            let row = sqlx::query("SELECT id, spec FROM campaigns WHERE idempotency_key = ?")
+                .bind(key)
+                .fetch_optional(&mut *tx)
+                .await?;
+            if let Some(row) = row {
+                let id: String = row.get("id");
+                let old: String = row.get("spec");
+                if old != spec_json {
+                    return Err(Error::Conflict(
+                        "Idempotency-Key already used for a different campaign".into(),
+                    ));
+                }
+                return Ok(CampaignCreated {
+                    id: parse_uuid(&id)?,
+                    jobs: jobs_total,
+                    impacts_total,
+                    created: false,
+                });
+            }
+        }
+        let id = Uuid::new_v4();
+        let now = now_ms();
+        let seq: i64 = sqlx::query(
+            "INSERT INTO campaigns (id, name, spec, samples, impacts_total, max_attempts,
+                                    idempotency_key, created_ms)
+             VALUES (?, ?, ?, ?, ?, ?, ?, ?) RETURNING rowid",
+        )
+        .bind(id.to_string())
+        .bind(&spec.name)
+        .bind(&spec_json)
+        .bind(spec.samples as i64)
+        .bind(impacts_total as i64)
+        .bind(self.max_attempts as i64)
+        .bind(idempotency_key)
+        .bind(now)
+        .fetch_one(&mut *tx)
+        .await?
+        .get(0);
+        for cell in &cells {
+            sqlx::query(
+                "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, impacts, params)
+                 VALUES (?, ?, ?, ?, ?, ?, ?)",
+            )
+            .bind(id.to_string())
+            .bind(cell.index as i64)
+            .bind(cell.params.angle_deg)
+            .bind(cell.params.shape.name())
+            .bind(serde_json::to_string(&cell.swept).map_err(|e| Error::Internal(e.to_string()))?)
+            .bind(cell.impacts as i64)
+            .bind(
+                serde_json::to_string(&cell.params)
+                    .map_err(|e| Error::Internal(e.to_string()))?,
+            )
+            .execute(&mut *tx)
+            .await?;
+        }
+        // Multi-row inserts keep a campaign of many thousand jobs to a few statements; 400
+        // rows × 8 values stays under SQLite's limit on bound variables.
+        let jobs: Vec<(u32, u32, u32, u64)> = cells
+            .iter()
+            .flat_map(|c| {
+                (0..spec.samples).map(move |s| {
+                    (
+                        c.index,
+                        s,
+                        c.impacts,
+                        grit_erosion::campaign::job_seed(spec.seed, c.index, s),
+                    )
+                })
+            })
+            .collect();
+        for chunk in jobs.chunks(400) {
+            let mut qb = QueryBuilder::<Sqlite>::new(
+                "INSERT INTO jobs (campaign_id, campaign_seq, cell_index, sample_index, seed,
+                                   impacts_planned, state, updated_ms) ",
+            );
+            qb.push_values(chunk, |mut b, (cell, sample, impacts, seed)| {
+                b.push_bind(id.to_string())
+                    .push_bind(seq)
+                    .push_bind(*cell as i64)
+                    .push_bind(*sample as i64)
+                    .push_bind(*seed as i64)
+                    .push_bind(*impacts as i64)
+                    .push_bind("queued")
+                    .push_bind(now);
+            });
+            qb.build().execute(&mut *tx).await?;
+        }
+        tx.commit().await?;
+        tracing::info!(campaign = %id, jobs = jobs_total, impacts_total, "campaign created");
+        Ok(CampaignCreated {
+            id,
+            jobs: jobs_total,
+            impacts_total,
+            created: true,
+        })
+    }
+
+    /// Every campaign, newest first, with state and progress.
+    pub async fn list_campaigns(&self) -> Result<Vec<CampaignSummary>> {
+        let rows = sqlx::query(
+            "SELECT c.id, c.name, c.impacts_total, c.created_ms, c.cancelled_ms,
+                    COALESCE(SUM(j.impacts_done), 0) AS done,
+                    COALESCE(SUM(j.state = 'queued'), 0) AS queued,
+                    COALESCE(SUM(j.state = 'leased'), 0) AS leased,
+                    COALESCE(SUM(j.state = 'done'), 0) AS jobs_done,
+                    COALESCE(SUM(j.state = 'failed'), 0) AS failed,
+                    COUNT(j.id) AS jobs
+             FROM campaigns c LEFT JOIN jobs j ON j.campaign_id = c.id
+             GROUP BY c.id ORDER BY c.created_ms DESC, c.rowid DESC",
+        )
+        .fetch_all(&self.read)
+        .await?;
+        rows.iter()
+            .map(|r| {
+                let counts = JobCounts {
+                    queued: r.get::<i64, _>("queued") as u64,
+                    leased: r.get::<i64, _>("leased") as u64,
+                    done: r.get::<i64, _>("jobs_done") as u64,
+                    failed: r.get::<i64, _>("failed") as u64,
+                    cancelled: 0,
+                };
+                let impacts_done = r.get::<i64, _>("done") as u64;
+                Ok(CampaignSummary {
+                    id: parse_uuid(&r.get::<String, _>("id"))?,
+                    name: r.get("name"),
+                    state: derive_state(
+                        r.get::<Option<i64>, _>("cancelled_ms").is_some(),
+                        &counts,
+                        r.get::<i64, _>("jobs") as u64,
+                        impacts_done,
+                    ),
+                    impacts_done,
+                    impacts_total: r.get::<i64, _>("impacts_total") as u64,
+                    created_ms: r.get("created_ms"),
+                })
+            })
+            .collect()
+    }
+
+    async fn campaign_row(&self, id: Uuid) -> Result<sqlx::sqlite::SqliteRow> {
+        sqlx::query("SELECT * FROM campaigns WHERE id = ?")
+            .bind(id.to_string())
+            .fetch_optional(&self.read)
+            .await?
+            .ok_or_else(|| Error::NotFound(format!("campaign {id}")))
+    }
+
+    /// Progress of one campaign: jobs per state, impacts, per-cell progress, rate, ETA.
+    pub async fn status(&self, id: Uuid) -> Result<CampaignStatus> {
+        let c = self.campaign_row(id).await?;
+        let ids = id.to_string();
+        let mut counts = JobCounts::default();
+        for r in sqlx::query(
+            "SELECT state, COUNT(*) AS n FROM jobs WHERE campaign_id = ? GROUP BY state",
+        )
+        .bind(&ids)
+        .fetch_all(&self.read)
+        .await?
+        {
+            let n = r.get::<i64, _>("n") as u64;
+            match r.get::<String, _>("state").as_str() {
+                "queued" => counts.queued = n,
+                "leased" => counts.leased = n,
+                "done" => counts.done = n,
+                "failed" => counts.failed = n,
+                _ => counts.cancelled += n,
+            }
+        }
+        let samples = c.get::<i64, _>("samples") as u64;
+        let mut cells = Vec::new();
+        for r in sqlx::query(
+            "SELECT k.cell_index, k.angle_deg, k.shape, k.swept, k.impacts,
+                    COALESCE(SUM(j.impacts_done), 0) AS done,
+                    COALESCE(SUM(j.state = 'done'), 0) AS samples_done
+             FROM cells k LEFT JOIN jobs j
+               ON j.campaign_id = k.campaign_id AND j.cell_index = k.cell_index
+             WHERE k.campaign_id = ? GROUP BY k.cell_index ORDER BY k.cell_index",
+        )
+        .bind(&ids)
+        .fetch_all(&self.read)
+        .await?
+        {
+            cells.push(CellProgress {
+                cell: r.get::<i64, _>("cell_index") as u32,
+                angle_deg: r.get("angle_deg"),
+                shape: r.get("shape"),
+                swept: serde_json::from_str(&r.get::<String, _>("swept")).unwrap_or_default(),
+                samples_done: r.get::<i64, _>("samples_done") as u64,
+                samples_total: samples,
+                impacts_done: r.get::<i64, _>("done") as u64,
+                impacts_total: r.get::<i64, _>("impacts") as u64 * samples,
+            });
+        }
+        let impacts_done: u64 = cells.iter().map(|c| c.impacts_done).sum();
+        let impacts_total = c.get::<i64, _>("impacts_total") as u64;
+        let now = now_ms();
+        let recent = sqlx::query(
+            "SELECT COUNT(*) AS n, MIN(i.created_ms) AS first FROM impacts i
+             JOIN jobs j ON j.id = i.job_id
+             WHERE j.campaign_id = ? AND i.created_ms > ?",
+        )
+        .bind(&ids)
+        .bind(now - RATE_WINDOW_MS)
+        .fetch_one(&self.read)
+        .await?;
+        let n: i64 = recent.get("n");
+        // Over a window that starts at the first recent impact, so a fresh campaign's rate is
+        // not diluted by the minutes before it started.
+        let rate = recent
+            .get::<Option<i64>, _>("first")
+            .filter(|_| n > 1)
+            .map(|first| n as f64 / ((now - first).max(1000) as f64 / 1000.0));
+        let cancelled = c.get::<Option<i64>, _>("cancelled_ms").is_some();
+        let total_jobs =
+            counts.queued + counts.leased + counts.done + counts.failed + counts.cancelled;
+        let state = derive_state(cancelled, &counts, total_jobs, impacts_done);
+        let eta = match state {
+            CampaignState::Done => Some(0.0),
+            CampaignState::Queued | CampaignState::Running => rate
+                .filter(|r| *r > 0.0)
+                .map(|r| impacts_total.saturating_sub(impacts_done) as f64 / r),
+            _ => None,
+        };
+        let last_error = sqlx::query(
+            "SELECT id, cell_index, sample_index, attempts, last_error FROM jobs
+             WHERE campaign_id = ? AND state = 'failed' ORDER BY updated_ms DESC LIMIT 1",
+        )
+        .bind(&ids)
+        .fetch_optional(&self.read)
+        .await?
+        .map(|r| JobError {
+            job_id: r.get("id"),
+            cell: r.get::<i64, _>("cell_index") as u32,
+            sample: r.get::<i64, _>("sample_index") as u32,
+            attempts: r.get::<i64, _>("attempts") as u32,
+            error: r.get::<Option<String>, _>("last_error").unwrap_or_default(),
+        });
+        Ok(CampaignStatus {
+            id,
+            name: c.get("name"),
+            state,
+            impacts_done,
+            impacts_total,
+            jobs: counts,
+            rate_impacts_per_s: rate,
+            eta_s: eta,
+            cells,
+            last_error,
+            created_ms: c.get("created_ms"),
+        })
+    }
+
+    /// Aggregated results (partial while jobs remain); with `raw`, every sample's series.
+    pub async fn results(&self, id: Uuid, raw: bool) -> Result<ResultsResponse> {
+        let c = self.campaign_row(id).await?;
+        let spec = CampaignSpec::from_json(&c.get::<String, _>("spec"))?;
+        let cells = spec.cells()?;
+        let rows = sqlx::query(
+            "SELECT j.cell_index, j.sample_index, i.grain_mass_kg, i.mass_loss_kg
+             FROM impacts i JOIN jobs j ON j.id = i.job_id
+             WHERE j.campaign_id = ?
+             ORDER BY j.cell_index, j.sample_index, i.impact",
+        )
+        .bind(id.to_string())
+        .fetch_all(&self.read)
+        .await?;
+        let mut per_cell: Vec<BTreeMap<u32, Vec<Impact>>> = vec![BTreeMap::new(); cells.len()];
+        for r in &rows {
+            let cell = r.get::<i64, _>(0) as usize;
+            let sample = r.get::<i64, _>(1) as u32;
+            if let Some(m) = per_cell.get_mut(cell) {
+                m.entry(sample).or_default().push(Impact {
+                    grain_mass_kg: r.get(2),
+                    mass_loss_kg: r.get(3),
+                });
+            }
+        }
+        let inputs: Vec<_> = cells
+            .iter()
+            .zip(per_cell)
+            .map(|(cell, samples)| {
+                cell.input(
+                    spec.samples,
+                    samples
+                        .into_iter()
+                        .map(|(sample, impacts)| SampleInput { sample, impacts })
+                        .collect(),
+                )
+            })
+            .collect();
+        let results = aggregate_campaign(&inputs, grit_erosion::SLOPE_WINDOW)
+            .map_err(|e| Error::Internal(format!("aggregation: {e}")))?;
+        let raw = if raw {
+            Some(self.raw_series(id).await?)
+        } else {
+            None
+        };
+        Ok(ResultsResponse { results, raw })
+    }
+
+    async fn raw_series(&self, id: Uuid) -> Result<Vec<RawSample>> {
+        let jobs = sqlx::query(
+            "SELECT id, cell_index, sample_index, seed, state FROM jobs
+             WHERE campaign_id = ? ORDER BY cell_index, sample_index",
+        )
+        .bind(id.to_string())
+        .fetch_all(&self.read)
+        .await?;
+        let rows = sqlx::query(
+            "SELECT i.job_id, i.record FROM impacts i JOIN jobs j ON j.id = i.job_id
+             WHERE j.campaign_id = ? ORDER BY i.job_id, i.impact",
+        )
+        .bind(id.to_string())
+        .fetch_all(&self.read)
+        .await?;
+        let mut records: BTreeMap<i64, Vec<ImpactRecord>> = BTreeMap::new();
+        for r in rows {
+            let rec: ImpactRecord = serde_json::from_str(&r.get::<String, _>(1))
+                .map_err(|e| Error::Internal(format!("stored impact record: {e}")))?;
+            records.entry(r.get(0)).or_default().push(rec);
+        }
+        Ok(jobs
+            .iter()
+            .map(|j| RawSample {
+                cell: j.get::<i64, _>("cell_index") as u32,
+                sample: j.get::<i64, _>("sample_index") as u32,
+                seed: j.get::<i64, _>("seed") as u64,
+                state: j.get("state"),
+                impacts: records.remove(&j.get::<i64, _>("id")).unwrap_or_default(),
+            })
+            .collect())
+    }
+
+    /// A campaign's jobs in cell and sample order, only those in `state` if given, at most
+    /// `limit` of them.
+    pub async fn jobs(
+        &self,
+        id: Uuid,
+        state: Option<JobState>,
+        limit: u32,
+    ) -> Result<Vec<JobInfo>> {
+        self.campaign_row(id).await?;
+        let rows = sqlx::query(
+            "SELECT id, cell_index, sample_index, state, attempts, impacts_done, impacts_planned,
+                    worker, lease_expires_ms, updated_ms, last_error
+             FROM jobs WHERE campaign_id = ?1 AND (?2 IS NULL OR state = ?2)
+             ORDER BY cell_index, sample_index LIMIT ?3",
+        )
+        .bind(id.to_string())
+        .bind(state.map(JobState::as_str))
+        .bind(limit as i64)
+        .fetch_all(&self.read)
+        .await?;
+        rows.iter()
+            .map(|r| {
+                Ok(JobInfo {
+                    job_id: r.get("id"),
+                    cell: r.get::<i64, _>("cell_index") as u32,
+                    sample: r.get::<i64, _>("sample_index") as u32,
+                    state: job_state(&r.get::<String, _>("state"))?,
+                    attempts: r.get::<i64, _>("attempts") as u32,
+                    impacts_done: r.get::<i64, _>("impacts_done") as u32,
+                    impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
+                    worker: r.get("worker"),
+                    lease_expires_ms: r.get("lease_expires_ms"),
+                    updated_ms: r.get("updated_ms"),
+                    last_error: r.get("last_error"),
+                })
+            })
+            .collect()
+    }
+
+    /// Cancels a campaign: unfinished jobs become `cancelled` (their holders learn it at the
+    /// next heartbeat). Returns how many jobs changed.
+    pub async fn cancel(&self, id: Uuid) -> Result<u64> {
+        let mut tx = self.begin().await?;
+        let now = now_ms();
+        let found = sqlx::query(
+            "UPDATE campaigns SET cancelled_ms = COALESCE(cancelled_ms, ?) WHERE id = ?",
+        )
+        .bind(now)
+        .bind(id.to_string())
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        if found == 0 {
+            return Err(Error::NotFound(format!("campaign {id}")));
+        }
+        // lease_id stays, so the holder's next heartbeat is told "cancelled" (410), not 409.
+        let n = sqlx::query(
+            "UPDATE jobs SET state = 'cancelled', lease_expires_ms = NULL, updated_ms = ?
+             WHERE campaign_id = ? AND state IN ('queued', 'leased', 'failed')",
+        )
+        .bind(now)
+        .bind(id.to_string())
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        sqlx::query(
+            "DELETE FROM checkpoints WHERE job_id IN
+               (SELECT id FROM jobs WHERE campaign_id = ? AND state = 'cancelled')",
+        )
+        .bind(id.to_string())
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        tracing::info!(campaign = %id, jobs = n, "campaign cancelled");
+        Ok(n)
+    }
+
+    /// Puts a campaign's failed jobs back in the queue with their attempts reset.
+    pub async fn retry_failed(&self, id: Uuid) -> Result<u64> {
+        let mut tx = self.begin().await?;
+        let row = sqlx::query("SELECT cancelled_ms FROM campaigns WHERE id = ?")
+            .bind(id.to_string())
+            .fetch_optional(&mut *tx)
+            .await?
+            .ok_or_else(|| Error::NotFound(format!("campaign {id}")))?;
+        if row.get::<Option<i64>, _>(0).is_some() {
+            return Err(Error::Conflict("campaign is cancelled".into()));
+        }
+        let n = sqlx::query(
+            "UPDATE jobs SET state = 'queued', attempts = 0, lease_id = NULL, worker = NULL,
+                             lease_expires_ms = NULL, updated_ms = ?
+             WHERE campaign_id = ? AND state = 'failed'",
+        )
+        .bind(now_ms())
+        .bind(id.to_string())
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        tx.commit().await?;
+        Ok(n)
+    }
+}
+
+fn job_state(s: &str) -> Result<JobState> {
+    JobState::parse(s).ok_or_else(|| Error::Internal(format!("stored job state {s:?}")))
+}
+
+fn derive_state(cancelled: bool, c: &JobCounts, total: u64, impacts_done: u64) -> CampaignState {
+    if cancelled {
+        CampaignState::Cancelled
+    } else if c.done == total {
+        CampaignState::Done
+    } else if c.queued == 0 && c.leased == 0 {
+        CampaignState::Failed
+    } else if c.leased == 0 && c.done == 0 && impacts_done == 0 {
+        CampaignState::Queued
+    } else {
+        CampaignState::Running
+    }
+}

@@ -1,0 +1,88 @@
+//! The coordinator's SQLite store. Every state change is one `BEGIN IMMEDIATE` transaction
+//! on the single writer connection; reads go through a separate read-only pool so status
+//! polling never queues behind writes (WAL lets readers run beside the writer). `Store` is
+//! the one handle; its queries sit by resource beside the HTTP routes: `campaigns`, `worker`
+//! (leases and what lease holders report) and `workers`.
+
+use std::path::Path;
+use std::str::FromStr;
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use sqlx::sqlite::{
+    SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
+};
+use sqlx::{Sqlite, Transaction};
+use uuid::Uuid;
+
+use crate::error::{Error, Result};
+
+mod campaigns;
+mod worker;
+mod workers;
+
+#[cfg(test)]
+mod tests;
+
+/// Current time in Unix milliseconds.
+pub fn now_ms() -> i64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_millis() as i64)
+        .unwrap_or(0)
+}
+
+/// The coordinator database.
+#[derive(Clone)]
+pub struct Store {
+    write: SqlitePool,
+    read: SqlitePool,
+    /// Lease length.
+    pub lease_ttl: Duration,
+    /// Attempts (lost or failed leases) after which a job stays `failed`.
+    pub max_attempts: u32,
+}
+
+impl Store {
+    /// Opens (creating if missing) the database at `path` and applies the migrations.
+    pub async fn open(path: &Path, lease_ttl: Duration, max_attempts: u32) -> Result<Store> {
+        let opts = SqliteConnectOptions::new()
+            .filename(path)
+            .create_if_missing(true)
+            .journal_mode(SqliteJournalMode::Wal)
+            // NORMAL in WAL mode survives a crashed process (the tests kill the coordinator);
+            // only an OS crash can lose the last transactions.
+            .synchronous(SqliteSynchronous::Normal)
+            .busy_timeout(Duration::from_secs(30))
+            .foreign_keys(true);
+        let write = SqlitePoolOptions::new()
+            .max_connections(1)
+            .connect_with(opts.clone())
+            .await?;
+        sqlx::migrate!("../../migrations").run(&write).await?;
+        let read = SqlitePoolOptions::new()
+            .max_connections(4)
+            .connect_with(opts.read_only(true))
+            .await?;
+        Ok(Store {
+            write,
+            read,
+            lease_ttl,
+            max_attempts: max_attempts.max(1),
+        })
+    }
+
+    async fn begin(&self) -> Result<Transaction<'static, Sqlite>> {
+        Ok(self.write.begin_with("BEGIN IMMEDIATE").await?)
+    }
+
+    /// Liveness check: the database answers a query.
+    pub async fn ping(&self) -> Result<()> {
+        sqlx::query("SELECT 1").execute(&self.read).await?;
+        Ok(())
+    }
+}
+
+/// Parses a uuid the store wrote.
+fn parse_uuid(s: &str) -> Result<Uuid> {
+    Uuid::from_str(s).map_err(|e| Error::Internal(format!("stored id {s}: {e}")))
+}

@@ -1,0 +1,115 @@
+//! The store's lease, failure and workers bookkeeping, without HTTP.
+
+use std::path::Path;
+use std::time::Duration;
+
+use grit_erosion::campaign::CampaignSpec;
+use uuid::Uuid;
+
+use super::Store;
+use crate::api::{CampaignState, JobState};
+
+const TINY: &str = r#"{"angles_deg": [90], "shapes": ["hexagon"], "samples": 2, "impacts": 2,
+    "allow_short_samples": true, "spacing_m": 25e-6}"#;
+
+async fn store(dir: &Path, ttl_ms: u64) -> Store {
+    Store::open(&dir.join("t.db"), Duration::from_millis(ttl_ms), 2)
+        .await
+        .unwrap()
+}
+
+#[tokio::test]
+async fn expired_leases_count_attempts_until_the_job_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 1).await;
+    let spec = CampaignSpec::from_json(TINY).unwrap();
+    let id = s.create_campaign(&spec, None).await.unwrap().id;
+    // Sample 0 first (claim order), then the other.
+    let a = s.claim("w").await.unwrap().unwrap();
+    assert_eq!(a.sample, 0);
+    tokio::time::sleep(Duration::from_millis(5)).await;
+    let b = s.claim("w").await.unwrap().unwrap();
+    assert_eq!(
+        b.job_id, a.job_id,
+        "the expired job is first in the queue again"
+    );
+    tokio::time::sleep(Duration::from_millis(5)).await;
+    s.reap_expired().await.unwrap();
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.jobs.failed, 1);
+    assert_eq!(st.jobs.queued, 1);
+    let e = st.last_error.unwrap();
+    assert_eq!(e.attempts, 2);
+    assert!(e.error.contains("lease expired"), "{}", e.error);
+    assert_eq!(s.retry_failed(id).await.unwrap(), 1);
+    assert_eq!(s.status(id).await.unwrap().jobs.queued, 2);
+}
+
+#[tokio::test]
+async fn workers_are_listed_idle_or_with_the_job_they_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    assert!(s.claim("idle").await.unwrap().is_none());
+    let spec = CampaignSpec::from_json(TINY).unwrap();
+    let id = s.create_campaign(&spec, None).await.unwrap().id;
+    let j = s.claim("busy").await.unwrap().unwrap();
+    tokio::time::sleep(Duration::from_millis(5)).await;
+    s.heartbeat(j.job_id, j.lease_id, &[], None).await.unwrap();
+    let w = s.workers(Duration::from_secs(60)).await.unwrap();
+    let names: Vec<&str> = w.workers.iter().map(|w| w.name.as_str()).collect();
+    assert_eq!(names, ["busy", "idle"], "most recently seen first");
+    let held = &w.workers[0].jobs;
+    assert_eq!(held.len(), 1);
+    assert_eq!((held[0].job_id, held[0].campaign_id), (j.job_id, id));
+    assert_eq!(held[0].last_heartbeat_ms, w.workers[0].last_seen_ms);
+    assert!(w.workers[1].jobs.is_empty());
+    // A failed attempt clears the job's worker, but the worker stays listed.
+    s.fail(j.job_id, j.lease_id, "boom", &[]).await.unwrap();
+    let w = s.workers(Duration::from_secs(60)).await.unwrap();
+    assert!(w.workers.iter().all(|w| w.jobs.is_empty()));
+    let queued = s.jobs(id, Some(JobState::Queued), 10).await.unwrap();
+    assert_eq!(queued.len(), 2);
+    assert_eq!(queued[0].last_error.as_deref(), Some("boom"));
+    assert_eq!(s.jobs(id, None, 1).await.unwrap().len(), 1);
+    let e = s.jobs(Uuid::new_v4(), None, 10).await.unwrap_err();
+    assert_eq!(e.status(), axum::http::StatusCode::NOT_FOUND);
+}
+
+#[tokio::test]
+async fn failure_reports_keep_the_error_and_stale_leases_get_409() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let spec = CampaignSpec::from_json(TINY).unwrap();
+    let id = s.create_campaign(&spec, None).await.unwrap().id;
+    let j = s.claim("w").await.unwrap().unwrap();
+    let e = s
+        .heartbeat(j.job_id, Uuid::new_v4(), &[], None)
+        .await
+        .unwrap_err();
+    assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
+    s.fail(j.job_id, j.lease_id, "impact 1: unstable", &[])
+        .await
+        .unwrap();
+    let e = s
+        .fail(j.job_id, j.lease_id, "again", &[])
+        .await
+        .unwrap_err();
+    assert_eq!(
+        e.status(),
+        axum::http::StatusCode::CONFLICT,
+        "the lease ended"
+    );
+    let j2 = s.claim("w").await.unwrap().unwrap();
+    s.fail(j2.job_id, j2.lease_id, "impact 1: unstable", &[])
+        .await
+        .unwrap();
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.jobs.failed + st.jobs.queued, 2);
+    assert_eq!(
+        st.last_error.map(|e| e.error).as_deref(),
+        Some("impact 1: unstable")
+    );
+    assert_eq!(s.cancel(id).await.unwrap(), 2);
+    assert!(s.claim("w").await.unwrap().is_none());
+    assert_eq!(s.status(id).await.unwrap().state, CampaignState::Cancelled);
+}

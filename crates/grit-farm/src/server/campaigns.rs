@@ -1,0 +1,225 @@
+//! Campaign endpoints, all under the submit token: submit, list, status, results, jobs,
+//! cancel and retry-failed.
+
+use std::collections::BTreeMap;
+
+use axum::body::Bytes;
+use axum::extract::{Path, Query, State};
+use axum::http::{HeaderMap, StatusCode};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use grit_erosion::campaign::CampaignSpec;
+use serde::Deserialize;
+use uuid::Uuid;
+
+use super::{unknown_param, AppState};
+// Glob so the `utoipa::path` attributes below find the schema types (and ErrorBody) by name.
+use crate::api::*;
+use crate::error::{Error, Result};
+
+/// The campaign routes, relative to `/api/v1`.
+pub fn router() -> Router<AppState> {
+    Router::new()
+        .route("/campaigns", post(create_campaign).get(list_campaigns))
+        .route("/campaigns/{id}", get(campaign_status))
+        .route("/campaigns/{id}/results", get(campaign_results))
+        .route("/campaigns/{id}/jobs", get(campaign_jobs))
+        .route("/campaigns/{id}/cancel", post(cancel_campaign))
+        .route("/campaigns/{id}/retry-failed", post(retry_failed))
+}
+
+/// The campaign endpoints' part of the OpenAPI document.
+#[derive(utoipa::OpenApi)]
+#[openapi(paths(
+    create_campaign,
+    list_campaigns,
+    campaign_status,
+    campaign_results,
+    campaign_jobs,
+    cancel_campaign,
+    retry_failed
+))]
+pub struct Doc;
+
+/// A campaign id from the path; one that is not a uuid names no campaign (404).
+fn campaign_id(raw: &str) -> Result<Uuid> {
+    raw.parse()
+        .map_err(|_| Error::NotFound(format!("campaign {raw}")))
+}
+
+/// Submits a campaign (issue 3 campaign spec).
+#[utoipa::path(post, path = "/api/v1/campaigns",
+    request_body(content = Object, description = "campaign spec (issue 3); every field optional"),
+    params(("Idempotency-Key" = Option<String>, Header, description = "a retried submit with the same key returns the first campaign")),
+    responses((status = 201, body = CampaignCreated), (status = 200, body = CampaignCreated, description = "idempotent replay"),
+        (status = 400, body = ErrorBody), (status = 401), (status = 409, body = ErrorBody), (status = 413), (status = 422, body = ErrorBody)),
+    security(("submit_token" = [])))]
+async fn create_campaign(
+    State(s): State<AppState>,
+    headers: HeaderMap,
+    body: Bytes,
+) -> Result<(StatusCode, Json<CampaignCreated>)> {
+    let text = std::str::from_utf8(&body).map_err(|_| Error::BadRequest {
+        status: StatusCode::BAD_REQUEST,
+        message: "body is not UTF-8 JSON".into(),
+    })?;
+    let spec = CampaignSpec::from_json(text).map_err(|e| {
+        if e.field == "(json)" {
+            Error::BadRequest {
+                status: StatusCode::BAD_REQUEST,
+                message: format!("malformed JSON: {}", e.rule),
+            }
+        } else {
+            e.into()
+        }
+    })?;
+    let key = headers
+        .get("idempotency-key")
+        .map(|v| {
+            v.to_str()
+                .map_err(|_| Error::invalid("Idempotency-Key", "must be ASCII"))
+        })
+        .transpose()?;
+    if key.is_some_and(|k| k.is_empty() || k.len() > 200) {
+        return Err(Error::invalid(
+            "Idempotency-Key",
+            "must be 1 to 200 characters",
+        ));
+    }
+    let created = s.store.create_campaign(&spec, key).await?;
+    let status = if created.created {
+        StatusCode::CREATED
+    } else {
+        StatusCode::OK
+    };
+    Ok((status, Json(created)))
+}
+
+#[utoipa::path(get, path = "/api/v1/campaigns",
+    responses((status = 200, body = Vec<CampaignSummary>), (status = 401)), security(("submit_token" = [])))]
+async fn list_campaigns(State(s): State<AppState>) -> Result<Json<Vec<CampaignSummary>>> {
+    Ok(Json(s.store.list_campaigns().await?))
+}
+
+#[utoipa::path(get, path = "/api/v1/campaigns/{id}", params(("id" = Uuid, Path)),
+    responses((status = 200, body = CampaignStatus), (status = 401), (status = 404, body = ErrorBody)),
+    security(("submit_token" = [])))]
+async fn campaign_status(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Json<CampaignStatus>> {
+    Ok(Json(s.store.status(campaign_id(&id)?).await?))
+}
+
+#[derive(Deserialize, utoipa::IntoParams)]
+struct ResultsQuery {
+    /// Include every sample's per-impact series.
+    #[serde(default)]
+    raw: bool,
+}
+
+#[utoipa::path(get, path = "/api/v1/campaigns/{id}/results", params(("id" = Uuid, Path), ResultsQuery),
+    responses((status = 200, body = ResultsResponse), (status = 401), (status = 404, body = ErrorBody)),
+    security(("submit_token" = [])))]
+async fn campaign_results(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    Query(q): Query<ResultsQuery>,
+) -> Result<Json<ResultsResponse>> {
+    Ok(Json(s.store.results(campaign_id(&id)?, q.raw).await?))
+}
+
+/// Query of `GET /campaigns/{id}/jobs`.
+#[derive(utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+struct JobsQuery {
+    /// Only jobs in this state.
+    #[param(inline)]
+    state: Option<JobState>,
+    /// At most this many jobs, 1 to 10000 (default 1000).
+    limit: Option<u32>,
+}
+
+/// Most jobs one `GET /campaigns/{id}/jobs` answers with.
+const MAX_JOBS_LIMIT: u32 = 10_000;
+
+impl JobsQuery {
+    fn parse(q: &BTreeMap<String, String>) -> Result<JobsQuery> {
+        let mut out = JobsQuery {
+            state: None,
+            limit: None,
+        };
+        for (key, value) in q {
+            match key.as_str() {
+                "state" => {
+                    out.state = Some(JobState::parse(value).ok_or_else(|| {
+                        Error::invalid(
+                            "state",
+                            format!(
+                                "must be one of {}, got {value:?}",
+                                JobState::ALL.map(JobState::as_str).join(", ")
+                            ),
+                        )
+                    })?)
+                }
+                "limit" => {
+                    out.limit = Some(
+                        value
+                            .parse()
+                            .ok()
+                            .filter(|n| (1..=MAX_JOBS_LIMIT).contains(n))
+                            .ok_or_else(|| {
+                                Error::invalid(
+                                    "limit",
+                                    format!(
+                                    "must be an integer from 1 to {MAX_JOBS_LIMIT}, got {value:?}"
+                                ),
+                                )
+                            })?,
+                    )
+                }
+                other => return Err(unknown_param(other, "state, limit")),
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// A campaign's jobs, e.g. `?state=failed` for the failed ones with their errors.
+#[utoipa::path(get, path = "/api/v1/campaigns/{id}/jobs", params(("id" = Uuid, Path), JobsQuery),
+    responses((status = 200, body = Vec<JobInfo>, description = "in cell and sample order"), (status = 401),
+        (status = 404, body = ErrorBody), (status = 422, body = ErrorBody, description = "a bad `state` or `limit`, or an unknown parameter")),
+    security(("submit_token" = [])))]
+async fn campaign_jobs(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    Query(q): Query<BTreeMap<String, String>>,
+) -> Result<Json<Vec<JobInfo>>> {
+    let id = campaign_id(&id)?;
+    let q = JobsQuery::parse(&q)?;
+    Ok(Json(
+        s.store.jobs(id, q.state, q.limit.unwrap_or(1000)).await?,
+    ))
+}
+
+#[utoipa::path(post, path = "/api/v1/campaigns/{id}/cancel", params(("id" = Uuid, Path)),
+    responses((status = 200, body = JobsChanged), (status = 401), (status = 404, body = ErrorBody)),
+    security(("submit_token" = [])))]
+async fn cancel_campaign(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Json<JobsChanged>> {
+    let jobs = s.store.cancel(campaign_id(&id)?).await?;
+    Ok(Json(JobsChanged { jobs }))
+}
+
+#[utoipa::path(post, path = "/api/v1/campaigns/{id}/retry-failed", params(("id" = Uuid, Path)),
+    responses((status = 200, body = JobsChanged), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody)),
+    security(("submit_token" = [])))]
+async fn retry_failed(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Json<JobsChanged>> {
+    let jobs = s.store.retry_failed(campaign_id(&id)?).await?;
+    Ok(Json(JobsChanged { jobs }))
+}
