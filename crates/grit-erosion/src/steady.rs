@@ -14,8 +14,8 @@
 //! The standard error of a slope assumes that the per-impact losses are independent, which
 //! they are: each impact is its own random draw of aim and orientation. The cumulative series
 //! is their running sum, so its residuals about a line are correlated, and the textbook
-//! `SSR/(n − 2)/Sxx` understates the error about 3.5-fold over 10 points; see
-//! [`slope_fit`] and `docs/erosion.md`.
+//! `SSR/(n − 2)/Sxx` understates the error several-fold; see [`slope_fit`] and
+//! `docs/erosion.md` (*Steady state*).
 
 use serde::{Deserialize, Serialize};
 
@@ -180,7 +180,7 @@ pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
             "only {n} impacts; two {STEADY_POINTS}-impact slopes need {window}"
         ));
     }
-    if let (Some(start), false) = (window_first_impact, samples.is_empty()) {
+    if let Some(start) = window_first_impact {
         let counts = mean[start - 1..].iter().map(|p| p.samples);
         let (lo, hi) = (counts.clone().min(), counts.max());
         if lo != hi {
