@@ -11,10 +11,15 @@
 //!
 //! Partial data (a campaign still running) aggregates the same way and is marked
 //! `partial: true`; every sum runs in sample-index order so results are reproducible.
+//!
+//! Each cell also carries a steady-state check of its mean series ([`crate::steady`]), and
+//! the campaign says whether every cell passed it.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
+
+use crate::steady::{self, SteadyState};
 
 /// Number of final impacts whose slope is a sample's erosion (seed paper section 4).
 pub const SLOPE_WINDOW: usize = 20;
@@ -138,6 +143,21 @@ pub struct CellResult {
     pub mean_series: Vec<MeanPoint>,
     /// Running erosion mean and std with the number of samples (Fig. 10a).
     pub convergence: Vec<ConvergencePoint>,
+    /// Whether the last-20 window is past incubation and linear (section 4); `null` in
+    /// results files written before the check existed.
+    #[serde(default)]
+    pub steady_state: Option<SteadyState>,
+}
+
+impl CellResult {
+    /// The cell's name in messages: angle, shape and any other swept values.
+    pub fn label(&self) -> String {
+        let mut label = format!("{}° {}", self.angle_deg, self.shape);
+        for (name, value) in &self.swept {
+            label.push_str(&format!(" {name}={value}"));
+        }
+        label
+    }
 }
 
 /// Results of a campaign, complete or not (`GET /api/v1/campaigns/{id}/results`).
@@ -149,6 +169,53 @@ pub struct CampaignResults {
     pub slope_window: usize,
     /// One result per cell, in input order.
     pub cells: Vec<CellResult>,
+    /// Whether every cell passed the steady-state check; `null` when some cell was not
+    /// checked (results files written before the check existed).
+    #[serde(default)]
+    pub steady: Option<bool>,
+    /// The campaign spec as run, defaults filled in, when the caller supplied it
+    /// ([`CampaignResults::with_spec`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spec: Option<serde_json::Value>,
+    /// Version of grit that aggregated these results; `null` in older files.
+    #[serde(default)]
+    pub grit_version: Option<String>,
+}
+
+impl CampaignResults {
+    /// These results with the campaign spec that produced them, for a reader to rerun it.
+    pub fn with_spec(mut self, spec: serde_json::Value) -> Self {
+        self.spec = Some(spec);
+        self
+    }
+
+    /// Whether every cell is steady: `None` when some cell carries no check.
+    pub fn cells_steady(&self) -> Option<bool> {
+        self.cells
+            .iter()
+            .map(|c| c.steady_state.as_ref().map(|s| s.steady))
+            .try_fold(true, |all, s| s.map(|s| all && s))
+    }
+
+    /// One line per cell that is not at steady state, or was not checked, saying why
+    /// (seed paper section 4: erosion from the steady, linear part of the curve).
+    pub fn unsteady_warnings(&self) -> Vec<String> {
+        self.cells
+            .iter()
+            .filter_map(|c| match &c.steady_state {
+                Some(s) if s.steady => None,
+                Some(s) => Some(format!(
+                    "warning: cell {} is not at steady state: {}",
+                    c.label(),
+                    s.reason
+                )),
+                None => Some(format!(
+                    "warning: cell {}: steady state not checked (results written before the check)",
+                    c.label()
+                )),
+            })
+            .collect()
+    }
 }
 
 /// Data that cannot be aggregated; names the field (`cells[1].samples[3].impacts[7]...`).
@@ -365,7 +432,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
     }
 
     let longest = series.iter().map(Vec::len).max().unwrap_or(0);
-    let mean_series = (0..longest)
+    let mean_series: Vec<MeanPoint> = (0..longest)
         .map(|k| {
             let reached: Vec<&SeriesPoint> = series.iter().filter_map(|s| s.get(k)).collect();
             let n = reached.len() as f64;
@@ -381,6 +448,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         })
         .collect();
 
+    let steady_state = steady::assess(&series, &mean_series);
     let summary = stats(&slopes);
     let partial = samples.len() < cell.planned_samples
         || series.iter().any(|s| s.len() < cell.planned_impacts);
@@ -400,6 +468,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         per_sample,
         mean_series,
         convergence: convergence(&slopes),
+        steady_state: Some(steady_state),
     })
 }
 
@@ -413,11 +482,16 @@ pub fn aggregate_campaign(
         .enumerate()
         .map(|(i, c)| aggregate_cell(c, window).map_err(|e| e.within(&format!("cells[{i}]"))))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(CampaignResults {
+    let mut results = CampaignResults {
         partial: cells.iter().any(|c| c.partial),
         slope_window: window,
         cells,
-    })
+        steady: None,
+        spec: None,
+        grit_version: Some(env!("CARGO_PKG_VERSION").to_string()),
+    };
+    results.steady = results.cells_steady();
+    Ok(results)
 }
 
 #[cfg(test)]

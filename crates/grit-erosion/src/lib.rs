@@ -11,6 +11,7 @@ pub mod impact;
 pub mod sample;
 pub mod shapes;
 pub mod stability;
+pub mod steady;
 pub mod studies;
 pub mod sweep;
 
@@ -25,3 +26,4 @@ pub use fits::{
 pub use impact::{ImpactError, ImpactOutcome, ImpactParams, Numerics};
 pub use sample::{ImpactRecord, Sample, SampleError};
 pub use shapes::{Shape, ShapeError, ShapeInfo};
+pub use steady::{SlopeFit, SteadyState};

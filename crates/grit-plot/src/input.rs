@@ -149,6 +149,7 @@ pub fn merge(inputs: Vec<(String, PlotInput)>) -> Result<(PlotInput, Vec<String>
             _ => None,
         };
     }
+    merged.results.steady = merged.results.cells_steady();
     Ok((merged, notes))
 }
 

@@ -1,0 +1,248 @@
+//! Whether a cell's erosion was measured at steady state (seed paper section 4, Figs. 8, 10b).
+//!
+//! The paper takes erosion as the slope of the mass-loss curve once it is "rather steady and
+//! linear", after the incubation period. A campaign that stops too early still yields a
+//! last-20 slope, but one that mixes incubation with erosion. This module checks the cell's
+//! mean series (Fig. 10b) against three conditions, all of which must hold:
+//!
+//! 1. the least-squares slope over the last [`STEADY_POINTS`] impacts agrees with the slope
+//!    over the [`STEADY_POINTS`] before them within [`STEADY_SIGMAS`] combined standard errors;
+//! 2. at least [`STEADY_INCUBATED_PERCENT`] % of the samples lost their first mass at or
+//!    before the first impact of that 20-impact window, so the window is past incubation;
+//! 3. the last slope is positive.
+//!
+//! The standard error of a slope assumes that the per-impact losses are independent, which
+//! they are: each impact is its own random draw of aim and orientation. The cumulative series
+//! is their running sum, so its residuals about a line are correlated, and the textbook
+//! `SSR/(n − 2)/Sxx` understates the error several-fold; see [`slope_fit`] and
+//! `docs/erosion.md` (*Steady state*).
+
+use serde::{Deserialize, Serialize};
+
+use crate::aggregate::{MeanPoint, SeriesPoint, SLOPE_WINDOW};
+
+/// Impacts in each of the two slopes compared: the last and the previous half of the
+/// paper's last-20 window (section 4).
+pub const STEADY_POINTS: usize = SLOPE_WINDOW / 2;
+
+/// Largest difference of the two slopes, in combined standard errors
+/// `√(se_last² + se_prev²)`, that still counts as agreement (about a 95 % two-sided test).
+pub const STEADY_SIGMAS: f64 = 2.0;
+
+/// Smallest share of samples, in percent, that must have lost mass by the first impact of
+/// the last-20 window: one sample in five may still be incubating (see `docs/erosion.md`).
+pub const STEADY_INCUBATED_PERCENT: usize = 80;
+
+/// A least-squares slope with its standard error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SlopeFit {
+    /// Slope of cumulative mass loss against cumulative grain mass (dimensionless).
+    pub value: f64,
+    /// Standard error of the slope under independent per-impact losses.
+    pub sem: f64,
+}
+
+/// Impact number of the first mass loss, over the samples that lost any (1-based).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Incubation {
+    /// Earliest first loss.
+    pub min: usize,
+    /// Mean first loss.
+    pub mean: f64,
+    /// Latest first loss.
+    pub max: usize,
+}
+
+/// A cell's steady-state check (seed paper section 4: erosion from the "rather steady and
+/// linear" part of the mass-loss curve, after incubation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SteadyState {
+    /// Whether all three conditions of the module documentation hold.
+    pub steady: bool,
+    /// Why, in words: every broken condition, or the evidence that none is.
+    pub reason: String,
+    /// First impact with mass loss, over samples that lost any; `null` when none did.
+    pub incubation_impacts: Option<Incubation>,
+    /// Reported samples that lost no mass at all: not incubated, left out of
+    /// `incubation_impacts` and counted against condition 2.
+    pub samples_without_loss: usize,
+    /// First impact of the last-20 window (1-based); `null` when the series is shorter.
+    pub window_first_impact: Option<usize>,
+    /// Reported samples whose first loss came at or before `window_first_impact`.
+    pub samples_incubated_by_window: usize,
+    /// Slope of the mean series over its last 10 impacts; `null` below 20 impacts.
+    pub slope_last10: Option<SlopeFit>,
+    /// Slope of the mean series over the 10 impacts before those; `null` below 20 impacts.
+    pub slope_prev10: Option<SlopeFit>,
+}
+
+/// Least-squares slope of y on x with its standard error for a cumulative series whose
+/// increments are independent: `None` below 3 points or for constant x.
+///
+/// With the increments `Δyⱼ = b·Δxⱼ + εⱼ`, εⱼ independent with variance σ², the slope is
+/// `b = Σⱼ wⱼ Δyⱼ` with `wⱼ = Σ_{k≥j} (x_k − x̄) / Sxx`, so `Var b = σ² Σⱼ wⱼ²`; σ² is
+/// estimated from the increments' residuals `Δyⱼ − b·Δxⱼ` with n − 2 degrees of freedom
+/// (n − 1 increments, one slope).
+pub fn slope_fit(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
+    let n = x.len().min(y.len());
+    if n < 3 {
+        return None;
+    }
+    let (x, y) = (&x[..n], &y[..n]);
+    let xm = x.iter().sum::<f64>() / n as f64;
+    let ym = y.iter().sum::<f64>() / n as f64;
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (xi, yi) in x.iter().zip(y) {
+        sxy += (xi - xm) * (yi - ym);
+        sxx += (xi - xm) * (xi - xm);
+    }
+    if sxx <= 0.0 {
+        return None;
+    }
+    let b = sxy / sxx;
+    // Tail sums of centred x, from the last point back: w_j for j = n-1 down to 1.
+    let (mut tail, mut sum_w2, mut ssr) = (0.0, 0.0, 0.0);
+    for j in (1..n).rev() {
+        tail += x[j] - xm;
+        let w = tail / sxx;
+        sum_w2 += w * w;
+        let u = (y[j] - y[j - 1]) - b * (x[j] - x[j - 1]);
+        ssr += u * u;
+    }
+    let sigma2 = ssr / (n - 2) as f64;
+    Some(SlopeFit {
+        value: b,
+        sem: (sigma2 * sum_w2).sqrt(),
+    })
+}
+
+/// The two slopes of the steady-state check (last 10 and the 10 before) from a mean series
+/// (Fig. 10b); both `None` when it has fewer than 20 points.
+pub fn mean_series_slopes(mean: &[MeanPoint]) -> (Option<SlopeFit>, Option<SlopeFit>) {
+    let n = mean.len();
+    if n < 2 * STEADY_POINTS {
+        return (None, None);
+    }
+    let fit = |part: &[MeanPoint]| {
+        let x: Vec<f64> = part.iter().map(|p| p.grain_mass_kg).collect();
+        let y: Vec<f64> = part.iter().map(|p| p.mass_loss_kg).collect();
+        slope_fit(&x, &y)
+    };
+    let last = &mean[n - STEADY_POINTS..];
+    let prev = &mean[n - 2 * STEADY_POINTS..n - STEADY_POINTS];
+    (fit(last), fit(prev))
+}
+
+/// Impact number (1-based) of a series' first mass loss; `None` when it lost nothing.
+pub fn first_loss_impact(series: &[SeriesPoint]) -> Option<usize> {
+    series
+        .iter()
+        .position(|p| p.mass_loss_kg > 0.0)
+        .map(|k| k + 1)
+}
+
+/// Erosion in mg of surface per g of grains, the unit of `docs/erosion.md`.
+fn mg_per_g(slope: f64) -> f64 {
+    slope * 1e3
+}
+
+fn show(fit: SlopeFit) -> String {
+    format!("{:.2} ± {:.2} mg/g", mg_per_g(fit.value), mg_per_g(fit.sem))
+}
+
+/// The steady-state check of one cell from its samples' cumulative series and their mean
+/// series (seed paper section 4, Figs. 8 and 10b); see the module documentation.
+pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
+    let first: Vec<Option<usize>> = samples.iter().map(|s| first_loss_impact(s)).collect();
+    let lost: Vec<usize> = first.iter().flatten().copied().collect();
+    let incubation_impacts = match (lost.iter().min(), lost.iter().max()) {
+        (Some(&min), Some(&max)) => Some(Incubation {
+            min,
+            mean: lost.iter().sum::<usize>() as f64 / lost.len() as f64,
+            max,
+        }),
+        _ => None,
+    };
+    let samples_without_loss = samples.len() - lost.len();
+    let n = mean.len();
+    let window = 2 * STEADY_POINTS;
+    let window_first_impact = (n >= window).then(|| n - window + 1);
+    let samples_incubated_by_window =
+        window_first_impact.map_or(0, |start| lost.iter().filter(|&&k| k <= start).count());
+    let (slope_last10, slope_prev10) = mean_series_slopes(mean);
+
+    let mut broken = Vec::new();
+    let mut held = Vec::new();
+    if samples.is_empty() {
+        broken.push("no samples reported".to_string());
+    } else if n < window {
+        broken.push(format!(
+            "only {n} impacts; two {STEADY_POINTS}-impact slopes need {window}"
+        ));
+    }
+    if let Some(start) = window_first_impact {
+        let counts = mean[start - 1..].iter().map(|p| p.samples);
+        let (lo, hi) = (counts.clone().min(), counts.max());
+        if lo != hi {
+            broken.push(format!(
+                "the last {window} points average {} to {} samples: some are still running",
+                lo.unwrap_or(0),
+                hi.unwrap_or(0)
+            ));
+        }
+        let share = format!(
+            "{samples_incubated_by_window} of {} samples lost mass by impact {start}, where \
+             the last-{window} window starts",
+            samples.len()
+        );
+        if samples_incubated_by_window * 100 >= STEADY_INCUBATED_PERCENT * samples.len() {
+            held.push(share);
+        } else {
+            broken.push(format!(
+                "only {share} ({STEADY_INCUBATED_PERCENT} % needed)"
+            ));
+        }
+    }
+    match (slope_last10, slope_prev10) {
+        (Some(last), Some(prev)) => {
+            let diff = (last.value - prev.value).abs();
+            let combined = (last.sem * last.sem + prev.sem * prev.sem).sqrt();
+            // Rounding alone must not split two slopes of an exactly linear series.
+            let rounding = 1e-9 * last.value.abs().max(prev.value.abs());
+            let agree = diff <= STEADY_SIGMAS * combined + rounding;
+            let z = if combined > 0.0 {
+                format!("{:.1} combined standard errors", diff / combined)
+            } else if diff <= rounding {
+                "no difference".to_string()
+            } else {
+                "a difference with no scatter".to_string()
+            };
+            let text = format!(
+                "last-{STEADY_POINTS} slope {} against the previous {STEADY_POINTS}'s {}: {z}",
+                show(last),
+                show(prev)
+            );
+            if agree {
+                held.push(text);
+            } else {
+                broken.push(format!("{text} (at most {STEADY_SIGMAS} allowed)"));
+            }
+            if last.value <= 0.0 {
+                broken.push(format!("no mass lost in the last {STEADY_POINTS} impacts"));
+            }
+        }
+        _ if n >= window => broken.push("the slopes could not be fitted".to_string()),
+        _ => {}
+    }
+    let steady = broken.is_empty();
+    SteadyState {
+        steady,
+        reason: if steady { held } else { broken }.join("; "),
+        incubation_impacts,
+        samples_without_loss,
+        window_first_impact,
+        samples_incubated_by_window,
+        slope_last10,
+        slope_prev10,
+    }
+}

@@ -1,0 +1,317 @@
+//! The steady-state check (seed paper section 4): incubating, steady and accelerating cells,
+//! slopes and standard errors against hand-computed values, and older results files.
+use std::collections::BTreeMap;
+
+use grit_erosion::aggregate::{aggregate_campaign, aggregate_cell, CellInput, SampleInput};
+use grit_erosion::steady::{slope_fit, STEADY_POINTS};
+use grit_erosion::{CampaignResults, Impact, SLOPE_WINDOW};
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+const GRAIN_KG: f64 = 1.2e-4;
+
+/// A sample whose impact k (0-based) loses `loss(k)` × grain mass.
+fn sample(index: u32, n: usize, loss: impl Fn(usize) -> f64) -> SampleInput {
+    SampleInput {
+        sample: index,
+        impacts: (0..n)
+            .map(|k| Impact {
+                grain_mass_kg: GRAIN_KG,
+                mass_loss_kg: loss(k) * GRAIN_KG,
+            })
+            .collect(),
+    }
+}
+
+fn cell(impacts: usize, samples: Vec<SampleInput>) -> CellInput {
+    CellInput {
+        angle_deg: 45.0,
+        shape: "hexagon".into(),
+        swept: BTreeMap::new(),
+        planned_samples: samples.len(),
+        planned_impacts: impacts,
+        samples,
+    }
+}
+
+/// Deterministic scatter in [-1, 1] that differs between samples and impacts.
+fn wiggle(s: u32, k: usize) -> f64 {
+    (1.7 * k as f64 + 2.3 * s as f64).sin()
+}
+
+/// Five samples of 70 impacts: first loss at impacts 5..=9, then `rate(k)` with ±60 % scatter.
+fn noisy_cell(rate: impl Fn(usize) -> f64) -> CellInput {
+    let samples = (0..5u32)
+        .map(|s| {
+            let start = 4 + s as usize;
+            sample(s, 70, |k| {
+                if k < start {
+                    0.0
+                } else {
+                    rate(k) * (1.0 + 0.6 * wiggle(s, k))
+                }
+            })
+        })
+        .collect();
+    cell(70, samples)
+}
+
+#[test]
+fn a_cell_still_in_incubation_is_not_steady() {
+    // No loss until impacts 64..=68 of 70: the last-20 window (from impact 51) is incubation.
+    let samples = (0..5u32)
+        .map(|s| {
+            let start = 63 + s as usize;
+            sample(s, 70, move |k| if k < start { 0.0 } else { 3e-3 })
+        })
+        .collect();
+    let r = aggregate_cell(&cell(70, samples), SLOPE_WINDOW).unwrap();
+    let s = r.steady_state.unwrap();
+    assert!(!s.steady, "{}", s.reason);
+    let inc = s.incubation_impacts.unwrap();
+    assert_eq!((inc.min, inc.max, inc.mean), (64, 68, 66.0));
+    assert_eq!(s.window_first_impact, Some(51));
+    assert_eq!(
+        (s.samples_incubated_by_window, s.samples_without_loss),
+        (0, 0)
+    );
+    assert!(
+        s.reason
+            .contains("only 0 of 5 samples lost mass by impact 51"),
+        "{}",
+        s.reason
+    );
+    assert_eq!(s.slope_prev10.unwrap().value, 0.0);
+}
+
+#[test]
+fn a_linear_cell_with_scatter_after_early_incubation_is_steady() {
+    let r = aggregate_cell(&noisy_cell(|_| 2e-3), SLOPE_WINDOW).unwrap();
+    let s = r.steady_state.unwrap();
+    assert!(s.steady, "{}", s.reason);
+    let inc = s.incubation_impacts.unwrap();
+    assert_eq!((inc.min, inc.max), (5, 9));
+    assert_eq!(s.samples_incubated_by_window, 5);
+    let (last, prev) = (s.slope_last10.unwrap(), s.slope_prev10.unwrap());
+    assert!(last.sem > 0.0 && prev.sem > 0.0);
+    for f in [last, prev] {
+        assert!((f.value - 2e-3).abs() < 3.0 * f.sem, "{f:?}");
+    }
+    assert!(
+        s.reason.contains("combined standard errors"),
+        "{}",
+        s.reason
+    );
+}
+
+#[test]
+fn a_rate_that_doubles_in_the_last_ten_is_not_steady() {
+    let r = aggregate_cell(
+        &noisy_cell(|k| if k >= 60 { 4e-3 } else { 2e-3 }),
+        SLOPE_WINDOW,
+    )
+    .unwrap();
+    let s = r.steady_state.unwrap();
+    assert!(!s.steady);
+    assert!(s.reason.contains("at most 2 allowed"), "{}", s.reason);
+    // Incubation is long over: the slopes alone break the rule.
+    assert_eq!(s.samples_incubated_by_window, 5);
+    assert!(s.slope_last10.unwrap().value > 1.5 * s.slope_prev10.unwrap().value);
+}
+
+#[test]
+fn a_cell_with_no_loss_in_its_last_ten_is_not_steady() {
+    let samples = vec![sample(0, 40, |k| if k < 25 { 2e-3 } else { 0.0 })];
+    let s = aggregate_cell(&cell(40, samples), SLOPE_WINDOW)
+        .unwrap()
+        .steady_state
+        .unwrap();
+    assert!(!s.steady);
+    assert!(
+        s.reason.contains("no mass lost in the last 10"),
+        "{}",
+        s.reason
+    );
+}
+
+#[test]
+fn too_short_or_lossless_or_ragged_cells_say_why() {
+    let short = aggregate_cell(&cell(19, vec![sample(0, 19, |_| 1e-3)]), SLOPE_WINDOW).unwrap();
+    let s = short.steady_state.unwrap();
+    assert!(!s.steady && s.slope_last10.is_none() && s.window_first_impact.is_none());
+    assert!(s.reason.contains("only 19 impacts"), "{}", s.reason);
+
+    let lossless = aggregate_cell(&cell(30, vec![sample(0, 30, |_| 0.0)]), SLOPE_WINDOW).unwrap();
+    let s = lossless.steady_state.unwrap();
+    assert!(!s.steady);
+    assert_eq!((s.incubation_impacts, s.samples_without_loss), (None, 1));
+
+    // One of two samples has 25 of 40 impacts: the window's mean changes samples midway.
+    let ragged = cell(40, vec![sample(0, 40, |_| 1e-3), sample(1, 25, |_| 1e-3)]);
+    let s = aggregate_cell(&ragged, SLOPE_WINDOW)
+        .unwrap()
+        .steady_state
+        .unwrap();
+    assert!(!s.steady);
+    assert!(s.reason.contains("average 1 to 2 samples"), "{}", s.reason);
+
+    let empty = aggregate_cell(&cell(30, vec![]), SLOPE_WINDOW).unwrap();
+    assert!(!empty.steady_state.unwrap().steady);
+}
+
+#[test]
+fn eighty_percent_of_samples_must_be_past_incubation() {
+    // Samples 0-3 lose from impact 2 on; sample 4 from `late` on (1-based impact late + 1).
+    let with_late = |late: usize| {
+        let mut samples: Vec<SampleInput> = (0..4u32)
+            .map(|s| sample(s, 70, |k| if k < 1 { 0.0 } else { 2e-3 }))
+            .collect();
+        samples.push(sample(4, 70, move |k| if k < late { 0.0 } else { 2e-3 }));
+        aggregate_cell(&cell(70, samples), SLOPE_WINDOW)
+            .unwrap()
+            .steady_state
+            .unwrap()
+    };
+    // Four of five (80 %) incubated by impact 51 suffices, even when the fifth never loses.
+    let s = with_late(70);
+    assert_eq!(
+        (s.samples_incubated_by_window, s.samples_without_loss),
+        (4, 1)
+    );
+    assert!(s.steady, "{}", s.reason);
+    // Three of five is too few, though the slopes agree.
+    let mut samples: Vec<SampleInput> = (0..3u32)
+        .map(|s| sample(s, 70, |k| if k < 1 { 0.0 } else { 2e-3 }))
+        .collect();
+    samples.extend((3..5u32).map(|s| sample(s, 70, |_| 0.0)));
+    let s = aggregate_cell(&cell(70, samples), SLOPE_WINDOW)
+        .unwrap()
+        .steady_state
+        .unwrap();
+    assert!(!s.steady);
+    assert!(s.reason.starts_with("only 3 of 5 samples"), "{}", s.reason);
+    // The late sample's start shows in the slopes unless it falls before the window.
+    let s = with_late(50);
+    assert_eq!(
+        s.samples_incubated_by_window, 5,
+        "first loss at 51 is at the window start"
+    );
+    assert!(s.steady, "{}", s.reason);
+}
+
+#[test]
+fn slope_and_standard_error_match_hand_values() {
+    // x = 1..4, y = 0, 1, 1, 3: x̄ = 2.5, Sxx = 5, Sxy = 4.5, so b = 0.9. The weights of the
+    // increments (1, 0, 2) are 1.5/5, 2/5, 1.5/5 (Σw² = 0.34); their residuals 0.1, −0.9, 1.1
+    // give σ² = 2.03/2, so se² = 1.015 × 0.34.
+    let f = slope_fit(&[1.0, 2.0, 3.0, 4.0], &[0.0, 1.0, 1.0, 3.0]).unwrap();
+    assert!((f.value - 0.9).abs() < 1e-12, "{f:?}");
+    assert!((f.sem - (1.015f64 * 0.34).sqrt()).abs() < 1e-12, "{f:?}");
+    assert!(slope_fit(&[1.0, 2.0], &[0.0, 1.0]).is_none());
+    assert!(slope_fit(&[1.0, 1.0, 1.0], &[0.0, 1.0, 2.0]).is_none());
+
+    // Through the cell: 20 impacts of one sample. Impacts 12..=20 (the increments inside
+    // the last-10 window) lose 1 grain-unit each except impact 16, which loses 3; the 10
+    // before lose 0.5 each. Over 10 equally spaced points wⱼ = (11 − j)(j − 1)/165 for
+    // j = 2..10, Σwⱼ = 1 and Σwⱼ² = 3333/27225; the jump sits at j = 6 (w = 25/165).
+    let g = 1e-3;
+    let one = sample(0, 20, |k| match k {
+        15 => 3.0 * g,
+        10..=19 => g,
+        _ => 0.5 * g,
+    });
+    let s = aggregate_cell(&cell(20, vec![one]), SLOPE_WINDOW)
+        .unwrap()
+        .steady_state
+        .unwrap();
+    let last = s.slope_last10.unwrap();
+    let b: f64 = 1.0 + 2.0 * 25.0 / 165.0;
+    let ssr = 8.0 * (1.0 - b) * (1.0 - b) + (3.0 - b) * (3.0 - b);
+    let se = (ssr / 8.0 * 3333.0 / 27225.0).sqrt();
+    assert!((last.value / g - b).abs() < 1e-9, "{last:?} vs {b}");
+    assert!((last.sem / g - se).abs() < 1e-9, "{last:?} vs {se}");
+    let prev = s.slope_prev10.unwrap();
+    assert!(
+        (prev.value / g - 0.5).abs() < 1e-9 && prev.sem / g < 1e-9,
+        "{prev:?}"
+    );
+    assert_eq!(STEADY_POINTS, 10);
+}
+
+#[test]
+fn the_standard_error_matches_the_scatter_of_slopes() {
+    // 4000 series of 10 impacts, each losing one unit with probability 0.2 (a failing
+    // particle): the rms standard error must match the spread of the fitted slopes. The
+    // residual-based textbook error would come out about 3.5 times too small here.
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let x: Vec<f64> = (1..=10).map(f64::from).collect();
+    let (mut slopes, mut se2) = (Vec::new(), 0.0);
+    for _ in 0..4000 {
+        let mut acc = 0.0;
+        let y: Vec<f64> = (0..10)
+            .map(|_| {
+                if rng.next_u32() < u32::MAX / 5 {
+                    acc += 1.0;
+                }
+                acc
+            })
+            .collect();
+        let f = slope_fit(&x, &y).unwrap();
+        slopes.push(f.value);
+        se2 += f.sem * f.sem;
+    }
+    let n = slopes.len() as f64;
+    let mean = slopes.iter().sum::<f64>() / n;
+    let sd = (slopes.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let rms_se = (se2 / n).sqrt();
+    assert!(
+        (rms_se / sd - 1.0).abs() < 0.1,
+        "rms se {rms_se} vs sd {sd}"
+    );
+}
+
+#[test]
+fn campaign_carries_steadiness_spec_and_version() {
+    let cells = [
+        noisy_cell(|_| 2e-3),
+        noisy_cell(|k| if k >= 60 { 4e-3 } else { 2e-3 }),
+    ];
+    let r = aggregate_campaign(&cells, SLOPE_WINDOW)
+        .unwrap()
+        .with_spec(serde_json::json!({"samples": 5}));
+    assert_eq!(r.steady, Some(false));
+    assert_eq!(r.grit_version.as_deref(), Some(env!("CARGO_PKG_VERSION")));
+    let warnings = r.unsteady_warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].starts_with("warning: cell 45° hexagon is not at steady state: last-10"));
+    let json = serde_json::to_value(&r).unwrap();
+    assert_eq!(json["spec"]["samples"], 5);
+    assert_eq!(json["cells"][0]["steady_state"]["steady"], true);
+    let back: CampaignResults = serde_json::from_value(json).unwrap();
+    assert_eq!(back, r);
+    let steady_only = aggregate_campaign(&cells[..1], SLOPE_WINDOW).unwrap();
+    assert_eq!(steady_only.steady, Some(true));
+    assert!(steady_only.unsteady_warnings().is_empty());
+    assert!(steady_only.spec.is_none());
+}
+
+#[test]
+fn older_results_files_still_load() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    for file in [
+        "tests/data/quick-results.json",
+        "tests/data/quick-raw-results.json",
+        "docs/erosion/reduced-results.json",
+    ] {
+        let text = std::fs::read_to_string(format!("{root}/{file}")).unwrap();
+        let r: CampaignResults = serde_json::from_str(&text).unwrap();
+        assert_eq!((r.steady, r.grit_version.as_ref()), (None, None), "{file}");
+        assert!(r.cells.iter().all(|c| c.steady_state.is_none()), "{file}");
+        let warnings = r.unsteady_warnings();
+        assert_eq!(warnings.len(), r.cells.len(), "{file}");
+        assert!(
+            warnings[0].contains("steady state not checked"),
+            "{warnings:?}"
+        );
+    }
+}
