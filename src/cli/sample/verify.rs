@@ -1,4 +1,5 @@
-//! `grit verify`: the seed's contact benchmarks and the engine's own checks, as a table.
+//! `grit verify`: the contact benchmarks of Mohseni-Mofidi et al. 2022 and the engine's own
+//! checks, as a table.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -85,7 +86,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for c in &rep.charts {
             let path = dir.join(format!("{}.svg", c.name));
-            crate::charts::line_chart(c, &path)?;
+            crate::cli::plot::line_chart(c, &path)?;
             eprintln!("wrote {}", path.display());
         }
     }
