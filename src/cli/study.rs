@@ -18,6 +18,9 @@ pub struct StudyArgs {
 enum Study {
     /// Runs a sample and each of its impacts again, from the same surface, with a stricter end
     /// criterion: mass loss and damage must not depend on when an impact ends.
+    #[command(
+        after_help = "Example: grit study settle --angle 45 --impacts 20 --strict-fraction 0.002"
+    )]
     Settle {
         #[command(flatten)]
         scene: SceneArgs,

@@ -15,7 +15,7 @@ pub struct SceneArgs {
     /// Grain shape: octagon, hexagon, square, rectangle or circle [default: hexagon].
     #[arg(long)]
     shape: Option<String>,
-    /// Particle spacing Δx (m); the paper's is 8e-6.
+    /// Particle spacing Δx (m); Mohseni-Mofidi et al. 2022 use 8e-6.
     #[arg(long)]
     spacing_m: Option<f64>,
     /// Impact speed (m/s).

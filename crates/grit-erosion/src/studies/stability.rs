@@ -114,9 +114,9 @@ impl Failure {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Panel {
-    /// Courant number against hourglass coefficient, the seed's contact model.
+    /// Courant number against hourglass coefficient, the paper's contact model.
     CflHourglass,
-    /// Contact stiffness against time step (as a Courant number), the seed's contact model,
+    /// Contact stiffness against time step (as a Courant number), the paper's contact model,
     /// with the contact springs not allowed to shorten the step.
     StiffnessStep,
     /// The same with the plain particle–particle penetration contact (seed Fig. 2b).

@@ -14,20 +14,21 @@ use crate::aggregate::{aggregate_cell, CellInput, SampleInput, SLOPE_WINDOW};
 use crate::impact::{ImpactParams, Numerics, MIN_SURFACE_LAYERS};
 use crate::sample::{Sample, SampleError};
 
-/// A numerical variant of the sweep: the seed's numerics, or one choice changed.
+/// A numerical variant of the sweep: the numerics of Mohseni-Mofidi et al. 2022 (`seed`), or one
+/// choice changed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Variant {
-    /// The seed's numerics (quintic kernel, eq. 4; Courant number 0.3).
+    /// The paper's numerics (quintic kernel, eq. 4; Courant number 0.3).
     Seed,
     /// The Wendland C2 kernel (support 2h, about 21 neighbours against the quintic's 48).
     WendlandC2,
-    /// The seed's numerics at another Courant number.
+    /// The paper's numerics at another Courant number.
     Cfl(f64),
-    /// The seed's numerics with the grain's approach flight simulated step by step, as before
+    /// The paper's numerics with the grain's approach flight simulated step by step, as before
     /// the flight skip (`Numerics::skip_flight`) became the default.
     FullFlight,
-    /// The seed's numerics with an absorbing layer of this many particle layers inside the
+    /// The paper's numerics with an absorbing layer of this many particle layers inside the
     /// surface's fixed bands (`Numerics::absorbing_layers`).
     Absorbing(f64),
 }
