@@ -12,7 +12,7 @@ use grit_erosion::studies::stability::{self, StabilityGrid, StabilityProgress, S
 use grit_erosion::studies::sweep::{
     cheapest_within, Cost, SweepProgress, SweepRow, SweepStudy, Variant,
 };
-use grit_erosion::{ImpactParams, Sample, Shape};
+use grit_erosion::{ImpactParams, Sample};
 
 use super::output::{say, write_csv, write_json};
 use super::{pool, progress};
@@ -295,10 +295,7 @@ fn impact(
     if repeat == 0 {
         bail!("--repeat: must be at least 1");
     }
-    let mut params = ImpactParams {
-        spacing_m,
-        ..ImpactParams::paper(angle, Shape::Hexagon)
-    };
+    let mut params = studies::scene(angle, spacing_m);
     params.numerics.grain_shell &= !full_grain;
     params.numerics.skip_flight &= !full_flight;
     params.numerics.cell_order |= cell_order;

@@ -2,6 +2,8 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::output::say;
+
 /// The style of every bar: what it counts, elapsed time, the bar, the count, a message.
 pub fn style() -> ProgressStyle {
     ProgressStyle::with_template("{prefix:>18} [{elapsed_precise}] {wide_bar} {pos}/{len} {msg}")
@@ -24,7 +26,7 @@ pub fn bar(len: u64, prefix: &str, show: bool) -> ProgressBar {
 /// is not a terminal (a log file): a hidden bar prints nothing.
 pub fn line(bar: &ProgressBar, line: &str) {
     if bar.is_hidden() {
-        println!("{line}");
+        say!("{line}");
     } else {
         bar.println(line);
     }

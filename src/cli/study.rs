@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use grit_erosion::studies::settle::{settle_study, SettleRow};
 
+use super::output::say;
 use super::sample::SceneArgs;
 use super::{pool, progress};
 
@@ -59,16 +60,16 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                 .install(|| settle_study(&p, seed, impacts, strict_fraction, |_| bar.inc(1)))?;
             bar.finish();
             if json {
-                println!("{}", serde_json::to_string_pretty(&rows)?);
+                say!("{}", serde_json::to_string_pretty(&rows)?);
                 return Ok(ExitCode::SUCCESS);
             }
-            println!(
+            say!(
                 "settle_fraction {} against {strict_fraction}",
                 p.settle_fraction
             );
-            println!("impact  loss_kg_m   loss_strict  dD        dD_strict  t_s        t_strict_s");
+            say!("impact  loss_kg_m   loss_strict  dD        dD_strict  t_s        t_strict_s");
             for r in &rows {
-                println!(
+                say!(
                     "{:>6}  {:>10.3e}  {:>10.3e}  {:>8.4}  {:>8.4}  {:>9.3e}  {:>9.3e}",
                     r.impact,
                     r.mass_loss_kg,
@@ -82,7 +83,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             let sum = |f: fn(&SettleRow) -> f64| -> f64 { rows.iter().map(f).sum() };
             let (d, ds) = (sum(|r| r.damage_added), sum(|r| r.damage_added_strict));
             let (m, ms) = (sum(|r| r.mass_loss_kg), sum(|r| r.mass_loss_strict_kg));
-            println!(
+            say!(
                 "total damage added {d:.4} vs {ds:.4} ({:+.2}%), mass loss {m:.3e} vs {ms:.3e} kg/m",
                 100.0 * (ds - d) / d.max(f64::MIN_POSITIVE)
             );

@@ -1,5 +1,6 @@
 //! `grit sample`: one sample of sequential random impacts run locally (Mohseni-Mofidi et al.
-//! 2022, section 4), with `grit shapes` and `grit verify`, the other commands on one scene.
+//! 2022, section 4); with it, `grit shapes` (the grain shapes) and `grit verify` (the engine's
+//! verification cases).
 
 mod scene;
 pub mod shapes;
@@ -19,7 +20,7 @@ use serde::Serialize;
 pub use scene::SceneArgs;
 use snapshots::Snapshots;
 
-use super::output::write_json;
+use super::output::{say, write_json};
 use super::{pool, progress};
 
 /// Arguments of `grit sample`.
@@ -178,11 +179,11 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             series: &out.series,
             erosion_last20: out.erosion_last20,
         };
-        println!("{}", serde_json::to_string(&short)?);
+        say!("{}", serde_json::to_string(&short)?);
     } else {
-        println!("impact  grain_mass_cum  mass_loss_cum  removed  steps  rebound");
+        say!("impact  grain_mass_cum  mass_loss_cum  removed  steps  rebound");
         for (pt, r) in out.series.iter().zip(s.records()) {
-            println!(
+            say!(
                 "{:>6}  {:>14.4e}  {:>13.4e}  {:>7}  {:>5}  {:>7.3}",
                 pt.impact,
                 pt.grain_mass_cum,
@@ -193,12 +194,12 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             );
         }
         match out.erosion_last20 {
-            Some(e) => println!("erosion (slope of the last {SLOPE_WINDOW} points): {e:.4e}"),
-            None => println!("erosion: needs at least {SLOPE_WINDOW} impacts"),
+            Some(e) => say!("erosion (slope of the last {SLOPE_WINDOW} points): {e:.4e}"),
+            None => say!("erosion: needs at least {SLOPE_WINDOW} impacts"),
         }
-        println!("wall time {:.1} s", t0.elapsed().as_secs_f64());
+        say!("wall time {:.1} s", t0.elapsed().as_secs_f64());
         if let Some(snap) = &snapshots {
-            println!(
+            say!(
                 "snapshots of {} impacts in {} (surface.pvd and grain.pvd open in ParaView)",
                 snap.written.len(),
                 snap.dir.display()

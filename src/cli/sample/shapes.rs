@@ -6,6 +6,8 @@ use std::process::ExitCode;
 use anyhow::Context;
 use grit_erosion::Shape;
 
+use crate::cli::output::say;
+
 /// Arguments of `grit shapes`.
 #[derive(clap::Args)]
 pub struct ShapesArgs {
@@ -25,16 +27,22 @@ pub fn shapes(a: ShapesArgs) -> anyhow::Result<ExitCode> {
         .collect::<Result<Vec<_>, _>>()
         .context("diameter_m")?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&infos)?);
+        say!("{}", serde_json::to_string_pretty(&infos)?);
     } else {
-        println!(
+        say!(
             "{:<10} {:>10} {:>12} {:>12}",
-            "shape", "angularity", "aspect_ratio", "area_m2"
+            "shape",
+            "angularity",
+            "aspect_ratio",
+            "area_m2"
         );
         for i in &infos {
-            println!(
+            say!(
                 "{:<10} {:>10.3} {:>12.3} {:>12.4e}",
-                i.name, i.angularity, i.aspect_ratio, i.area_m2
+                i.name,
+                i.angularity,
+                i.aspect_ratio,
+                i.area_m2
             );
         }
     }

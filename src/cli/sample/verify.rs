@@ -7,6 +7,8 @@ use std::process::ExitCode;
 use anyhow::Context;
 use grit_sph::verification::{elastic_impact, hertz, hourglass, sliding, slope, CaseReport, Row};
 
+use crate::cli::output::say;
+
 /// A verification case run at the chosen resolution.
 type Case = Box<dyn Fn() -> Result<CaseReport, grit_sph::SimError>>;
 
@@ -60,14 +62,18 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         rep.extend(f().with_context(|| format!("case {name}"))?);
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rep.rows)?);
+        say!("{}", serde_json::to_string_pretty(&rep.rows)?);
     } else {
-        println!(
+        say!(
             "{:<42} {:<40} {:>12} {:>12} {:>10}  pass",
-            "case", "resolution", "value", "reference", "error"
+            "case",
+            "resolution",
+            "value",
+            "reference",
+            "error"
         );
         for r in &rep.rows {
-            println!(
+            say!(
                 "{:<42} {:<40} {:>12.5e} {:>12.5e} {:>10.3e}  {}",
                 r.case,
                 r.resolution,
@@ -77,9 +83,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 pass_label(r)
             );
         }
-        println!();
+        say!();
         for r in &rep.rows {
-            println!("{}: {}", r.case, r.note);
+            say!("{}: {}", r.case, r.note);
         }
     }
     if let Some(dir) = &a.charts {
