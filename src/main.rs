@@ -1,16 +1,22 @@
-//! `grit`: the command-line front end. Subcommands live in their own modules; this file only
-//! parses arguments and dispatches.
+//! `grit`: the command-line front end. The commands live in `cli/`, one module per group; this
+//! file only parses the arguments and dispatches.
 
-mod charts;
-mod plot_cli;
-mod sample_cli;
-mod verify;
+mod cli;
+
+use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use cli::{bench, campaign, plot, sample, serve, study};
+
 /// Solid particle erosion predicted by SPH impact simulations.
 #[derive(Parser)]
-#[command(name = "grit", version, about)]
+#[command(
+    name = "grit",
+    version,
+    about,
+    after_help = "Example: grit run examples/quick.json --out out/quick"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -19,39 +25,97 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run the engine's verification cases and print case, resolution, value, reference, error.
-    Verify(verify::Args),
-    /// Print the built-in grain shapes with angularity and aspect ratio (seed Table 2).
-    Shapes(sample_cli::ShapesArgs),
+    #[command(after_help = "Example: grit verify --quick --only hertz")]
+    Verify(sample::verify::Args),
+    /// Print the built-in grain shapes with angularity and aspect ratio (Mohseni-Mofidi et al.
+    /// 2022, Table 2).
+    #[command(after_help = "Example: grit shapes --json")]
+    Shapes(sample::shapes::ShapesArgs),
     /// Run one sample (N sequential random impacts on a fresh surface) locally.
-    Sample(sample_cli::SampleArgs),
+    #[command(
+        after_help = "Example: grit sample --angle 45 --shape hexagon --impacts 70 --seed 1"
+    )]
+    Sample(sample::SampleArgs),
     /// Checks of the impact scene's own choices: `grit study settle`.
-    Study(sample_cli::StudyArgs),
+    #[command(after_help = "Example: grit study settle --angle 45 --impacts 20")]
+    Study(study::StudyArgs),
     /// Charts of a results file (PNG and SVG): mass loss, erosion against angle with Oka's
     /// model, normalised erosion, modified Oka, convergence.
-    Plot(plot_cli::Args),
-    /// Job farm: serve, work, run, submit, status, results, cancel, retry-failed, bench.
-    #[command(flatten)]
-    Farm(grit_farm::cli::FarmCommand),
+    #[command(after_help = "Example: grit plot out/quick/results.json --out out/charts")]
+    Plot(plot::Args),
+    /// Run the coordinator: REST API under /api/v1 on a SQLite database.
+    #[command(
+        after_help = "Example: GRIT_SUBMIT_TOKEN=s3cret GRIT_WORKER_TOKEN=w0rker grit serve --db grit.db --listen 0.0.0.0:8080"
+    )]
+    Serve(serve::ServeArgs),
+    /// Run a worker: lease jobs from a coordinator and simulate their impacts.
+    #[command(
+        after_help = "Example: grit work --coordinator http://coordinator:8080 --token-file worker.token --threads 4"
+    )]
+    Work(serve::WorkArgs),
+    /// Run a whole campaign on this machine (coordinator + local workers) and write results.
+    #[command(after_help = "Example: grit run examples/quick.json --out out/quick")]
+    Run(campaign::RunArgs),
+    /// Submit a campaign spec; prints the campaign id alone on the last line.
+    #[command(
+        after_help = "Example: grit submit examples/paper.json --coordinator http://coordinator:8080"
+    )]
+    Submit(campaign::SubmitArgs),
+    /// Show a campaign's progress (or every campaign without an id).
+    #[command(after_help = "Example: grit status 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40 --watch")]
+    Status(campaign::StatusArgs),
+    /// Fetch a campaign's aggregated results (partial while it runs).
+    #[command(
+        after_help = "Example: grit results 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40 --raw -o results.json"
+    )]
+    Results(campaign::ResultsArgs),
+    /// Cancel a campaign: no more jobs are handed out; running workers drop theirs.
+    #[command(after_help = "Example: grit cancel 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40")]
+    Cancel(campaign::IdArgs),
+    /// Put a campaign's failed jobs back in the queue.
+    #[command(after_help = "Example: grit retry-failed 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40")]
+    RetryFailed(campaign::IdArgs),
+    /// Benchmarks and numerical studies: one impact timed, the speed–accuracy sweep, the
+    /// stability map, and the coordinator's load test.
+    #[command(after_help = "Example: grit bench impact --spacing-m 1.5625e-5 --repeat 3")]
+    Bench(bench::BenchArgs),
 }
 
-fn main() -> std::process::ExitCode {
+fn main() -> ExitCode {
     let cli = Cli::parse();
     // plotters draws text only with registered fonts (the embedded DejaVu Sans), for every
     // chart in the binary, the verification SVGs included.
     grit_plot::register_fonts();
     let result = match cli.command {
-        Command::Verify(a) => verify::run(a),
-        Command::Shapes(a) => sample_cli::shapes(a),
-        Command::Sample(a) => sample_cli::sample(a),
-        Command::Study(a) => sample_cli::study(a),
-        Command::Plot(a) => plot_cli::run(a),
-        Command::Farm(c) => grit_farm::cli::dispatch(c).map_err(anyhow::Error::from),
+        Command::Verify(a) => sample::verify::run(a),
+        Command::Shapes(a) => sample::shapes::shapes(a),
+        Command::Sample(a) => sample::sample(a),
+        Command::Study(a) => study::study(a),
+        Command::Plot(a) => plot::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Serve(a) => farm("info", serve::serve(a)),
+        Command::Work(a) => farm("info", serve::work(a)),
+        Command::Run(a) => farm("warn", campaign::run(a)),
+        Command::Submit(a) => farm("warn", campaign::submit(a)),
+        Command::Status(a) => farm("warn", campaign::status(a)),
+        Command::Results(a) => farm("warn", campaign::results(a)),
+        Command::Cancel(a) => farm("warn", campaign::cancel(a)),
+        Command::RetryFailed(a) => farm("warn", campaign::retry_failed(a)),
     };
     match result {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
-            std::process::ExitCode::from(2)
+            ExitCode::from(2)
         }
     }
+}
+
+/// Runs a farm command on the async runtime, logging at `log` level unless `RUST_LOG` says.
+fn farm(
+    log: &str,
+    command: impl std::future::Future<Output = anyhow::Result<ExitCode>>,
+) -> anyhow::Result<ExitCode> {
+    cli::init_tracing(log);
+    cli::runtime()?.block_on(command)
 }

@@ -5,8 +5,8 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use grit_erosion::stability::{Failure, Panel, StabilityPoint, Verdict};
-use grit_erosion::sweep::SweepRow;
+use grit_erosion::studies::stability::{Failure, Panel, StabilityPoint, Verdict};
+use grit_erosion::studies::sweep::SweepRow;
 
 fn grit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_grit"))

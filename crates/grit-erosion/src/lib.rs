@@ -1,19 +1,17 @@
-//! grit-erosion: the science around the SPH engine (seed paper section 4): grain shapes
-//! and their shape factors, aggregation of per-impact mass losses into erosion, and the
-//! Oka and shape-modified Oka erosion models fitted to simulated erosion.
+//! grit-erosion: the science around the SPH engine (Mohseni-Mofidi et al. 2022, section 4):
+//! grain shapes and their shape factors, aggregation of per-impact mass losses into erosion,
+//! the Oka and shape-modified Oka erosion models fitted to simulated erosion, and the studies
+//! of the simulation's own choices (`studies`).
 #![warn(missing_docs)]
 
 pub mod aggregate;
-pub mod bench;
 pub mod campaign;
 pub mod fits;
 pub mod impact;
 pub mod sample;
 pub mod shapes;
-pub mod stability;
 pub mod steady;
 pub mod studies;
-pub mod sweep;
 
 pub use aggregate::{
     aggregate_campaign, aggregate_cell, AggregateError, CampaignResults, CellInput, CellResult,

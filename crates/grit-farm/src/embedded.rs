@@ -1,15 +1,15 @@
-//! `grit run`: a coordinator on a SQLite file in the output folder, N local workers, a
-//! progress bar, and the results JSON at the end. Running it again on the same folder with
-//! the same campaign resumes where it stopped (the submit is idempotent on the spec).
+//! The embedded mode behind `grit run`: a coordinator on a SQLite file in the output folder and
+//! N local workers in one process, run until the campaign ends; progress is reported through a
+//! callback and the results are returned. Running it again on the same folder with the same
+//! campaign resumes where it stopped (the submit is idempotent on the spec).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use grit_erosion::campaign::CampaignSpec;
-use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::api::{CampaignState, ResultsResponse};
-use crate::client::Client;
+use crate::api::{CampaignState, CampaignStatus, ResultsResponse};
+use crate::client::{Client, ClientError};
 use crate::db::Store;
 use crate::server::{self, Config, Secret};
 use crate::worker::{self, Stop, WorkerOptions};
@@ -17,7 +17,7 @@ use crate::worker::{self, Stop, WorkerOptions};
 /// Options of `grit run`.
 #[derive(Debug, Clone)]
 pub struct EmbeddedOptions {
-    /// Output folder: `grit.db` and `results.json` go there.
+    /// Output folder: the coordinator's `grit.db` goes there.
     pub out: PathBuf,
     /// Local workers.
     pub workers: usize,
@@ -25,21 +25,65 @@ pub struct EmbeddedOptions {
     pub threads_per_worker: Option<usize>,
     /// Checkpoint every this many impacts.
     pub checkpoint_every: u32,
-    /// Show the progress bar.
-    pub progress: bool,
-    /// Include every sample's per-impact series in results.json (as `?raw=true`).
+    /// Include every sample's per-impact series in the results (as `?raw=true`).
     pub raw: bool,
+}
+
+/// What the embedded run reports while it runs.
+#[derive(Debug)]
+pub enum RunEvent<'a> {
+    /// The campaign is in the database with this many impacts in all (an earlier, interrupted
+    /// run of the same campaign may have done some).
+    Started {
+        /// Impacts of the whole campaign.
+        impacts_total: u64,
+    },
+    /// The campaign's status, polled twice a second.
+    Status(&'a CampaignStatus),
+    /// A line worth showing: a failed job, a worker that stopped with an error.
+    Note(String),
 }
 
 /// What `grit run` produced.
 #[derive(Debug)]
 pub struct EmbeddedOutcome {
-    /// Final state of the campaign.
+    /// Final state of the campaign (not final when stopped from outside).
     pub state: CampaignState,
     /// The results, as the results endpoint serves them.
     pub results: ResultsResponse,
-    /// Where they were written.
-    pub results_path: PathBuf,
+}
+
+/// Why the embedded run could not go on.
+#[derive(Debug, thiserror::Error)]
+pub enum EmbeddedError {
+    /// The output folder could not be created.
+    #[error("--out {path}: {source}")]
+    OutDir {
+        /// The folder.
+        path: PathBuf,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// The database in the output folder could not be opened.
+    #[error("database {path}: {source}")]
+    Database {
+        /// The database file.
+        path: PathBuf,
+        /// What failed.
+        source: crate::Error,
+    },
+    /// A database operation failed.
+    #[error(transparent)]
+    Store(#[from] crate::Error),
+    /// The spec could not be written as JSON for its idempotency key.
+    #[error("campaign spec: {0}")]
+    Spec(#[from] serde_json::Error),
+    /// The local coordinator could not start.
+    #[error("cannot start the local coordinator: {0}")]
+    Start(std::io::Error),
+    /// A worker's client could not be built.
+    #[error(transparent)]
+    Client(#[from] ClientError),
 }
 
 /// FNV-1a, 64 bit: a stable digest of the spec, used as its idempotency key.
@@ -49,38 +93,30 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// Writes `value` as pretty JSON to `path` through a temporary file, so a reader never sees
-/// half a file.
-pub fn write_json(path: &Path, value: &impl serde::Serialize) -> std::io::Result<()> {
-    let tmp = path.with_extension("json.tmp");
-    let mut text = serde_json::to_string_pretty(value).map_err(std::io::Error::other)?;
-    text.push('\n');
-    std::fs::write(&tmp, text)?;
-    std::fs::rename(&tmp, path)
-}
-
-/// Runs `spec` to the end (or until `stop`), writing `results.json` into `opts.out`.
+/// Runs `spec` to the end (or until `stop`) and returns its results; `on_event` hears of the
+/// start, every status poll and anything worth a line.
 pub async fn run(
     spec: &CampaignSpec,
     opts: &EmbeddedOptions,
     stop: Stop,
-) -> Result<EmbeddedOutcome, String> {
-    std::fs::create_dir_all(&opts.out).map_err(|e| format!("--out {}: {e}", opts.out.display()))?;
+    mut on_event: impl FnMut(RunEvent<'_>),
+) -> Result<EmbeddedOutcome, EmbeddedError> {
+    std::fs::create_dir_all(&opts.out).map_err(|source| EmbeddedError::OutDir {
+        path: opts.out.clone(),
+        source,
+    })?;
     let db_path = opts.out.join("grit.db");
     let store = Store::open(&db_path, Duration::from_secs(120), 3)
         .await
-        .map_err(|e| format!("database {}: {e}", db_path.display()))?;
+        .map_err(|source| EmbeddedError::Database {
+            path: db_path.clone(),
+            source,
+        })?;
     // Nothing else uses this file, so leases left by an interrupted run are dead.
-    store
-        .requeue_all_leases()
-        .await
-        .map_err(|e| e.to_string())?;
-    let spec_json = serde_json::to_string(spec).map_err(|e| e.to_string())?;
+    store.requeue_all_leases().await?;
+    let spec_json = serde_json::to_string(spec)?;
     let key = format!("grit-run:{:016x}", fnv1a(spec_json.as_bytes()));
-    let created = store
-        .create_campaign(spec, Some(&key))
-        .await
-        .map_err(|e| e.to_string())?;
+    let created = store.create_campaign(spec, Some(&key)).await?;
     // Loopback only, with throwaway tokens: other local users cannot feed it results.
     let worker_token = uuid::Uuid::new_v4().to_string();
     let config = Config {
@@ -90,7 +126,7 @@ pub async fn run(
     };
     let running = server::start("127.0.0.1:0", store.clone(), config)
         .await
-        .map_err(|e| format!("cannot start the local coordinator: {e}"))?;
+        .map_err(EmbeddedError::Start)?;
     let base = format!("http://{}", running.addr);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let workers = opts.workers.max(1);
@@ -100,8 +136,7 @@ pub async fn run(
     let worker_stop = Stop::default();
     let mut handles = Vec::new();
     for i in 0..workers {
-        let client = Client::new(&base, Secret::new(Some(worker_token.clone())))
-            .map_err(|e| e.to_string())?;
+        let client = Client::new(&base, Secret::new(Some(worker_token.clone())))?;
         let wopts = WorkerOptions {
             name: format!("local-{i}"),
             threads: Some(threads),
@@ -116,64 +151,18 @@ pub async fn run(
         )));
     }
 
-    let bar = if opts.progress {
-        ProgressBar::new(created.impacts_total)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} impacts  {msg}",
-        )
-        .expect("valid template"),
-    );
-    // Without a terminal (a log file, a batch job) the bar draws nothing: say the same in a
-    // plain line now and then, so long campaigns still show progress.
-    let plain = opts.progress && !std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let started = std::time::Instant::now();
-    let mut last_line: Option<std::time::Instant> = None;
+    on_event(RunEvent::Started {
+        impacts_total: created.impacts_total,
+    });
     let state = loop {
-        let status = store.status(created.id).await.map_err(|e| e.to_string())?;
-        bar.set_position(status.impacts_done);
-        let rate = status
-            .rate_impacts_per_s
-            .map_or("rate –".to_string(), |r| format!("{:.3} impacts/s", r));
-        let eta = status.eta_s.map_or("ETA –".to_string(), |s| {
-            format!(
-                "ETA {}",
-                indicatif::HumanDuration(Duration::from_secs_f64(s))
-            )
-        });
-        bar.set_message(format!(
-            "{rate}  {eta}  jobs {}/{} done{}",
-            status.jobs.done,
-            status.jobs.done
-                + status.jobs.queued
-                + status.jobs.leased
-                + status.jobs.failed
-                + status.jobs.cancelled,
-            if status.jobs.failed > 0 {
-                format!(", {} failed", status.jobs.failed)
-            } else {
-                String::new()
-            }
-        ));
-        if plain && last_line.is_none_or(|t| t.elapsed() >= Duration::from_secs(30)) {
-            last_line = Some(std::time::Instant::now());
-            eprintln!(
-                "[{:>6.0} s] {}/{} impacts  {}",
-                started.elapsed().as_secs_f64(),
-                status.impacts_done,
-                status.impacts_total,
-                bar.message()
-            );
-        }
+        let status = store.status(created.id).await?;
+        on_event(RunEvent::Status(&status));
         if status.state.is_final() {
             if let Some(e) = &status.last_error {
-                bar.println(format!(
+                on_event(RunEvent::Note(format!(
                     "job of cell {} sample {} failed: {}",
                     e.cell, e.sample, e.error
-                ));
+                )));
             }
             break status.state;
         }
@@ -185,21 +174,11 @@ pub async fn run(
     for h in handles {
         match h.await {
             Ok(Ok(_)) => {}
-            Ok(Err(e)) => bar.println(format!("worker stopped: {e}")),
-            Err(e) => bar.println(format!("worker panicked: {e}")),
+            Ok(Err(e)) => on_event(RunEvent::Note(format!("worker stopped: {e}"))),
+            Err(e) => on_event(RunEvent::Note(format!("worker panicked: {e}"))),
         }
     }
-    bar.finish();
-    let results = store
-        .results(created.id, opts.raw)
-        .await
-        .map_err(|e| e.to_string())?;
-    let results_path = opts.out.join("results.json");
-    write_json(&results_path, &results).map_err(|e| format!("{}: {e}", results_path.display()))?;
+    let results = store.results(created.id, opts.raw).await?;
     running.stop().await;
-    Ok(EmbeddedOutcome {
-        state,
-        results,
-        results_path,
-    })
+    Ok(EmbeddedOutcome { state, results })
 }

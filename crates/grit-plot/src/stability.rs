@@ -4,7 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use grit_erosion::stability::{levels, spring_limit_cfl, Failure, Panel, StabilityPoint, Verdict};
+use grit_erosion::studies::stability::{
+    levels, spring_limit_cfl, Failure, Panel, StabilityPoint, Verdict,
+};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -172,7 +174,7 @@ pub fn stability_chart(
         format!(
             "Green dot: stable. Orange triangle: ran to the end, but total energy rose above {}× \
              its start. Red cross: the engine stopped; the letter names its diagnostic ({codes}).",
-            grit_erosion::stability::ENERGY_GAIN_LIMIT
+            grit_erosion::studies::stability::ENERGY_GAIN_LIMIT
         ),
         "Grey cells: a contact spring alone is unstable there, dt > 2√(m/k), i.e. \
          Courant number > 2/√(k/default)."

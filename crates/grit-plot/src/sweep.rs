@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use grit_erosion::sweep::{Cost, SweepRow};
+use grit_erosion::studies::sweep::{Cost, SweepRow};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;

@@ -1,14 +1,15 @@
-//! The stability map of issue 5: one impact of the seed's scene run with the numerical choices
-//! swept (Courant number against hourglass coefficient α of eq. 16; contact spring stiffness of
-//! eqs. 24–25 against the time step, for both contact models), each point marked stable or with
-//! the failure the engine raised.
+//! The stability map (`grit bench stability`): one impact of the paper's scene run with the
+//! numerical choices swept (Courant number against hourglass coefficient α of eq. 16; contact
+//! spring stiffness of eqs. 24–25 against the time step, for both contact models), each point
+//! marked stable or with the failure the engine raised.
 
 use std::cell::Cell;
 use std::time::Instant;
 
-use grit_sph::ContactModel;
+use grit_sph::{ContactModel, InputError};
 use serde::{Deserialize, Serialize};
 
+use super::StudyError;
 use crate::impact::{run_impact_observed, ImpactError, ImpactParams, Numerics};
 use crate::sample::{Sample, SampleError};
 
@@ -113,9 +114,9 @@ impl Failure {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Panel {
-    /// Courant number against hourglass coefficient, the seed's contact model.
+    /// Courant number against hourglass coefficient, the paper's contact model.
     CflHourglass,
-    /// Contact stiffness against time step (as a Courant number), the seed's contact model,
+    /// Contact stiffness against time step (as a Courant number), the paper's contact model,
     /// with the contact springs not allowed to shorten the step.
     StiffnessStep,
     /// The same with the plain particle–particle penetration contact (seed Fig. 2b).
@@ -241,13 +242,17 @@ impl StabilityGrid {
     }
 
     /// Checks every value against what the engine accepts; the error names the list.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InputError> {
         let check = |name: &str, v: &[f64], ok: &dyn Fn(f64) -> bool, rule: &str| {
+            let field = format!("--{name}");
             if v.is_empty() {
-                return Err(format!("--{name}: give at least one value"));
+                return Err(InputError::new(field, "give at least one value"));
             }
             match v.iter().find(|x| !ok(**x)) {
-                Some(x) => Err(format!("--{name}: {x} is out of range ({rule})")),
+                Some(x) => Err(InputError::new(
+                    field,
+                    format!("{x} is out of range ({rule})"),
+                )),
                 None => Ok(()),
             }
         };
@@ -374,6 +379,150 @@ pub fn run_point(
     Ok(point)
 }
 
+/// What `grit bench stability` maps: one scene, one surface state, the grid of numerics.
+#[derive(Debug, Clone)]
+pub struct StabilityStudy {
+    /// The scene (angle, spacing; its numerics are swept).
+    pub params: ImpactParams,
+    /// Seed of the sample the grain is drawn from.
+    pub seed: u64,
+    /// Impacts the surface takes (with the scene's own numerics) before the mapped one.
+    pub after: u32,
+    /// The grid.
+    pub grid: StabilityGrid,
+    /// Step budget over the steps the longest impact takes at the first step's dt.
+    pub budget_factor: f64,
+}
+
+/// What the stability map reports while it runs.
+#[derive(Debug, Clone, Copy)]
+pub enum StabilityProgress<'a> {
+    /// A point starts.
+    Start {
+        /// Its panel.
+        panel: Panel,
+        /// Its numerics.
+        numerics: &'a Numerics,
+    },
+    /// A point finished.
+    Done {
+        /// Its panel.
+        panel: Panel,
+        /// Its numerics.
+        numerics: &'a Numerics,
+        /// How it went.
+        point: &'a StabilityPoint,
+    },
+}
+
+impl StabilityStudy {
+    /// Checks the grid, the scene and the budget; errors name the option or scene field.
+    pub fn validate(&self) -> Result<(), StudyError> {
+        self.grid.validate()?;
+        self.params.validate()?;
+        if !(self.budget_factor.is_finite() && self.budget_factor > 0.0) {
+            return Err(InputError::new(
+                "--budget",
+                format!("must be > 0, got {}", self.budget_factor),
+            )
+            .into());
+        }
+        Ok(())
+    }
+
+    /// Prepares the surface, then runs every point of the grid from it, one after the other
+    /// (each on the current rayon pool), reporting each point's start and end to `progress`.
+    pub fn run(
+        &self,
+        mut progress: impl FnMut(StabilityProgress<'_>),
+    ) -> Result<Vec<StabilityPoint>, StudyError> {
+        self.validate()?;
+        let from = start(&self.params, self.seed, self.after)?;
+        let todo = self.grid.points();
+        let mut points = Vec::with_capacity(todo.len());
+        for (panel, numerics) in todo {
+            progress(StabilityProgress::Start {
+                panel,
+                numerics: &numerics,
+            });
+            let point = run_point(&from, panel, numerics, self.budget_factor)?;
+            progress(StabilityProgress::Done {
+                panel,
+                numerics: &numerics,
+                point: &point,
+            });
+            points.push(point);
+        }
+        Ok(points)
+    }
+
+    /// The chart's note on the scene.
+    pub fn note(&self) -> String {
+        let p = &self.params;
+        format!(
+            "Scene: hexagon at {}°, {} m/s, AISI 304, Δx = {:e} m ({:.0} particles per Dg), one impact on a surface after {} impacts, seed {}.",
+            p.angle_deg,
+            p.velocity_m_s,
+            p.spacing_m,
+            p.grain_diameter_m / p.spacing_m,
+            self.after,
+            self.seed
+        )
+    }
+}
+
+/// The map as text, one block per panel: the verdict of each Courant number (columns) at each
+/// hourglass α or stiffness (rows), and a legend.
+pub fn table(points: &[StabilityPoint]) -> String {
+    let mut s = String::new();
+    for panel in [
+        Panel::CflHourglass,
+        Panel::StiffnessStep,
+        Panel::StiffnessStepPenetration,
+    ] {
+        let pts: Vec<&StabilityPoint> = points.iter().filter(|p| p.panel == panel).collect();
+        if pts.is_empty() {
+            continue;
+        }
+        let y = |p: &StabilityPoint| panel.y(p);
+        let cfl = levels(pts.iter().map(|p| p.cfl));
+        let ys = levels(pts.iter().map(|p| y(p)));
+        let (name, yname) = match panel {
+            Panel::CflHourglass => ("Courant number × hourglass α, seed contact", "α"),
+            Panel::StiffnessStep => ("stiffness × step, seed contact", "k/k0"),
+            Panel::StiffnessStepPenetration => ("stiffness × step, penetration contact", "k/k0"),
+        };
+        s.push_str(&format!("{name}\n{yname:>8} |"));
+        for c in &cfl {
+            s.push_str(&format!(" {c:>5}"));
+        }
+        s.push('\n');
+        for yv in ys.iter().rev() {
+            s.push_str(&format!("{yv:>8} |"));
+            for c in &cfl {
+                let mark = pts
+                    .iter()
+                    .find(|p| p.cfl == *c && y(p) == *yv)
+                    .map(|p| match p.verdict {
+                        Verdict::Stable => "ok".to_string(),
+                        Verdict::EnergyGain => "E+".to_string(),
+                        Verdict::Unstable => format!("x:{}", p.failure.map_or("?", |f| f.code())),
+                    })
+                    .unwrap_or_default();
+                s.push_str(&format!(" {mark:>5}"));
+            }
+            s.push('\n');
+        }
+        s.push('\n');
+    }
+    s.push_str(&format!(
+        "ok stable · E+ finished, but energy rose above {}× · x: unstable ({})\n",
+        ENERGY_GAIN_LIMIT,
+        Failure::legend()
+    ));
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -413,12 +562,20 @@ mod tests {
             cfl: vec![0.3, 2.5],
             ..g.clone()
         };
-        assert!(bad.validate().unwrap_err().contains("--cfl: 2.5"));
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("--cfl: 2.5"));
         let empty = StabilityGrid {
             hourglass: vec![],
             ..g
         };
-        assert!(empty.validate().unwrap_err().contains("--hourglass"));
+        assert!(empty
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("--hourglass"));
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! The impact benchmark of issue 5: one impact of a sample, timed on 1 thread and on N threads
+//! The impact benchmark (`grit bench impact`): one impact of a sample, timed on 1 thread and on N threads
 //! from the same surface state, with the engine's per-stage timers.
 
 use std::collections::BTreeMap;

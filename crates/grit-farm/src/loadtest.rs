@@ -1,6 +1,7 @@
-//! `grit bench farm`: the coordinator alone under load. Clients claim a job, send one
-//! heartbeat and complete it with a placeholder impact; nothing is simulated (the only place
-//! in grit where a job does no simulation), so the figures are the coordinator's own cost.
+//! The coordinator's load test (`grit bench farm`): the coordinator alone under load. Clients
+//! claim a job, send one heartbeat and complete it with a placeholder impact; nothing is
+//! simulated (the only place in grit where a job does no simulation), so the figures are the
+//! coordinator's own cost.
 
 use std::time::{Duration, Instant};
 
@@ -9,13 +10,41 @@ use grit_erosion::{ImpactOutcome, ImpactRecord};
 use serde::Serialize;
 
 use crate::api::{CompleteRequest, HeartbeatRequest};
-use crate::client::Client;
+use crate::client::{Client, ClientError};
 use crate::db::Store;
 use crate::server::{self, Config, Secret};
 
+/// Why the load test could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadTestError {
+    /// A client count of zero, or none.
+    #[error("--clients: every count must be at least 1")]
+    Clients,
+    /// The scratch folder could not be created.
+    #[error("{path}: {source}")]
+    Dir {
+        /// The folder.
+        path: std::path::PathBuf,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// The coordinator could not start.
+    #[error("cannot start the coordinator: {0}")]
+    Start(std::io::Error),
+    /// The database failed.
+    #[error(transparent)]
+    Store(#[from] crate::Error),
+    /// A client request failed.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// A client task panicked or was cancelled.
+    #[error("load-test client: {0}")]
+    Task(#[from] tokio::task::JoinError),
+}
+
 /// Figures of one concurrency level.
 #[derive(Debug, Clone, Serialize)]
-pub struct BenchRow {
+pub struct LoadTestRow {
     /// Concurrent clients.
     pub clients: usize,
     /// Jobs claimed and completed.
@@ -38,17 +67,21 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[i]
 }
 
-/// Runs the benchmark for each client count, `seconds` each, on a fresh database in `dir`.
+/// Runs the load test for each client count, `seconds` each, on a fresh database in `dir`.
 pub async fn run(
     dir: &std::path::Path,
     clients: &[usize],
     seconds: f64,
-) -> Result<Vec<BenchRow>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+) -> Result<Vec<LoadTestRow>, LoadTestError> {
+    if clients.is_empty() || clients.contains(&0) {
+        return Err(LoadTestError::Clients);
+    }
+    std::fs::create_dir_all(dir).map_err(|source| LoadTestError::Dir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let db = dir.join(format!("bench-{}.db", uuid::Uuid::new_v4()));
-    let store = Store::open(&db, Duration::from_secs(60), 3)
-        .await
-        .map_err(|e| e.to_string())?;
+    let store = Store::open(&db, Duration::from_secs(60), 3).await?;
     let token = uuid::Uuid::new_v4().to_string();
     let config = Config {
         submit_token: Secret::new(Some(token.clone())),
@@ -57,7 +90,7 @@ pub async fn run(
     };
     let running = server::start("127.0.0.1:0", store.clone(), config)
         .await
-        .map_err(|e| e.to_string())?;
+        .map_err(LoadTestError::Start)?;
     let base = format!("http://{}", running.addr);
     let mut rows = Vec::new();
     for &n in clients {
@@ -66,17 +99,13 @@ pub async fn run(
             r#"{"angles_deg": [90], "shapes": ["hexagon"], "impacts": 1, "samples": 20000,
                 "allow_short_samples": true, "spacing_m": 25e-6}"#,
         )
-        .map_err(|e| e.to_string())?;
-        store
-            .create_campaign(&spec, None)
-            .await
-            .map_err(|e| e.to_string())?;
+        .map_err(crate::Error::from)?;
+        store.create_campaign(&spec, None).await?;
         let deadline = Instant::now() + Duration::from_secs_f64(seconds);
         let start = Instant::now();
         let mut tasks = Vec::new();
         for i in 0..n {
-            let client =
-                Client::new(&base, Secret::new(Some(token.clone()))).map_err(|e| e.to_string())?;
+            let client = Client::new(&base, Secret::new(Some(token.clone())))?;
             tasks.push(tokio::spawn(client_loop(
                 client,
                 format!("bench-{i}"),
@@ -86,13 +115,13 @@ pub async fn run(
         let mut jobs = 0;
         let mut lat = Vec::new();
         for t in tasks {
-            let (j, l) = t.await.map_err(|e| e.to_string())??;
+            let (j, l) = t.await??;
             jobs += j;
             lat.extend(l);
         }
         let secs = start.elapsed().as_secs_f64();
         lat.sort_by(f64::total_cmp);
-        let row = BenchRow {
+        let row = LoadTestRow {
             clients: n,
             jobs,
             seconds: secs,
@@ -100,11 +129,11 @@ pub async fn run(
             heartbeat_p50_ms: percentile(&lat, 0.50),
             heartbeat_p99_ms: percentile(&lat, 0.99),
         };
-        tracing::info!(?row, "bench level done");
+        tracing::info!(?row, "load-test level done");
         rows.push(row);
         // Drop the rest of the queue so the next level starts from the same state.
-        for c in store.list_campaigns().await.map_err(|e| e.to_string())? {
-            store.cancel(c.id).await.map_err(|e| e.to_string())?;
+        for c in store.list_campaigns().await? {
+            store.cancel(c.id).await?;
         }
     }
     running.stop().await;
@@ -118,11 +147,11 @@ async fn client_loop(
     client: Client,
     name: String,
     deadline: Instant,
-) -> Result<(u64, Vec<f64>), String> {
+) -> Result<(u64, Vec<f64>), ClientError> {
     let mut jobs = 0;
     let mut lat = Vec::new();
     while Instant::now() < deadline {
-        let Some(job) = client.claim(&name).await.map_err(|e| e.to_string())? else {
+        let Some(job) = client.claim(&name).await? else {
             break;
         };
         let t = Instant::now();
@@ -135,8 +164,7 @@ async fn client_loop(
                     checkpoint: None,
                 },
             )
-            .await
-            .map_err(|e| e.to_string())?;
+            .await?;
         lat.push(t.elapsed().as_secs_f64() * 1e3);
         let record = ImpactRecord {
             impact: 1,
@@ -163,15 +191,14 @@ async fn client_loop(
                     impacts: vec![record],
                 },
             )
-            .await
-            .map_err(|e| e.to_string())?;
+            .await?;
         jobs += 1;
     }
     Ok((jobs, lat))
 }
 
 /// The rows as a Markdown table.
-pub fn table(rows: &[BenchRow]) -> String {
+pub fn table(rows: &[LoadTestRow]) -> String {
     let mut s = String::from(
         "| clients | jobs | claims+completions/s | heartbeat p50 (ms) | heartbeat p99 (ms) |\n|---:|---:|---:|---:|---:|\n",
     );

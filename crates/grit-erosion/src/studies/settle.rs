@@ -1,5 +1,6 @@
-//! Checks of the choices seed section 4 leaves to us: when an impact may end, and how large
-//! the surface must be (issue 3: "show with numbers that the mass loss does not depend on it").
+//! When an impact may end, a choice Mohseni-Mofidi et al. 2022 (section 4) leaves open: each
+//! impact of a sample run again with a stricter end criterion shows with numbers that the mass
+//! loss does not depend on it.
 
 use serde::{Deserialize, Serialize};
 

@@ -1,39 +1,42 @@
-//! The speed–accuracy sweep of issue 5: erosion of the hexagon at one angle (the last-20 slope
-//! of seed section 4) and the Hertz p0 error (eq. 31) at several resolutions and numerical
-//! variants, each against the wall time per impact.
+//! The speed–accuracy sweep (`grit bench sweep`): erosion of the hexagon at one angle (the
+//! last-20 slope of Mohseni-Mofidi et al. 2022, section 4) and the Hertz p0 error (eq. 31) at
+//! several resolutions and numerical variants, each against the wall time per impact.
 
 use std::time::Instant;
 
 use grit_sph::verification::hertz;
-use grit_sph::{KernelKind, Settings};
+use grit_sph::{InputError, KernelKind, Settings};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::StudyError;
 use crate::aggregate::{aggregate_cell, CellInput, SampleInput, SLOPE_WINDOW};
 use crate::impact::{ImpactParams, Numerics, MIN_SURFACE_LAYERS};
 use crate::sample::{Sample, SampleError};
 
-/// A numerical variant of the sweep: the seed's numerics, or one choice changed.
+/// A numerical variant of the sweep: the numerics of Mohseni-Mofidi et al. 2022 (`seed`), or one
+/// choice changed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Variant {
-    /// The seed's numerics (quintic kernel, eq. 4; Courant number 0.3).
+    /// The paper's numerics (quintic kernel, eq. 4; Courant number 0.3).
     Seed,
     /// The Wendland C2 kernel (support 2h, about 21 neighbours against the quintic's 48).
     WendlandC2,
-    /// The seed's numerics at another Courant number.
+    /// The paper's numerics at another Courant number.
     Cfl(f64),
-    /// The seed's numerics with the grain's approach flight simulated step by step, as before
+    /// The paper's numerics with the grain's approach flight simulated step by step, as before
     /// the flight skip (`Numerics::skip_flight`) became the default.
     FullFlight,
-    /// The seed's numerics with an absorbing layer of this many particle layers inside the
+    /// The paper's numerics with an absorbing layer of this many particle layers inside the
     /// surface's fixed bands (`Numerics::absorbing_layers`).
     Absorbing(f64),
 }
 
 impl Variant {
     /// Parses `seed`, `wendland_c2`, `full_flight`, `cfl=X` or `absorbing=N`.
-    pub fn parse(s: &str) -> Result<Variant, String> {
+    pub fn parse(s: &str) -> Result<Variant, InputError> {
+        let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
@@ -41,18 +44,18 @@ impl Variant {
             other if other.starts_with("absorbing=") => {
                 match other["absorbing=".len()..].parse::<f64>() {
                     Ok(n) if n.is_finite() && n > 0.0 => Ok(Variant::Absorbing(n)),
-                    _ => Err(format!(
-                        "--variants: `{other}`: the absorbing layer needs a number of layers > 0"
+                    _ => bad(format!(
+                        "`{other}`: the absorbing layer needs a number of layers > 0"
                     )),
                 }
             }
             other => match other.strip_prefix("cfl=").map(str::parse::<f64>) {
                 Some(Ok(c)) if c > 0.0 && c <= grit_sph::world::MAX_CFL => Ok(Variant::Cfl(c)),
-                Some(_) => Err(format!(
-                    "--variants: `{other}`: the Courant number must be in (0, 2]"
+                Some(_) => bad(format!(
+                    "`{other}`: the Courant number must be in (0, 2]"
                 )),
-                None => Err(format!(
-                    "--variants: unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X, absorbing=N)"
+                None => bad(format!(
+                    "unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X, absorbing=N)"
                 )),
             },
         }
@@ -299,6 +302,182 @@ pub fn cheapest_within(rows: &[SweepRow]) -> Option<&SweepRow> {
         .min_by(|a, b| cost.get(a).total_cmp(&cost.get(b)))
 }
 
+/// What `grit bench sweep` runs: every variant at its resolutions, `samples` samples of
+/// `impacts` impacts each.
+#[derive(Debug, Clone)]
+pub struct SweepStudy {
+    /// The scene (angle; spacing and numerics are swept).
+    pub params: ImpactParams,
+    /// Particles per grain diameter.
+    pub ppd: Vec<f64>,
+    /// Numerical variants; the first is the reference whose finest row judges the others.
+    pub variants: Vec<Variant>,
+    /// Resolutions the variants after the first run at (all of `ppd` when empty).
+    pub variant_ppd: Vec<f64>,
+    /// Samples per resolution.
+    pub samples: u32,
+    /// Impacts per sample.
+    pub impacts: u32,
+    /// Seed of sample 0 (sample k uses seed + k).
+    pub seed: u64,
+}
+
+/// What the sweep reports while it runs.
+#[derive(Debug, Clone, Copy)]
+pub enum SweepProgress {
+    /// A (variant, resolution) point starts.
+    Point {
+        /// The variant.
+        variant: Variant,
+        /// Particles per grain diameter.
+        ppd: f64,
+    },
+    /// An impact of the point finished (reported from the pool's threads).
+    Impact,
+}
+
+impl SweepStudy {
+    /// Checks the options and the scene; errors name the option or scene field.
+    pub fn validate(&self) -> Result<(), StudyError> {
+        let bad = |field: &str, rule: String| Err(InputError::new(field, rule).into());
+        if self.ppd.is_empty() || self.ppd.iter().any(|p| !(p.is_finite() && *p >= 6.0)) {
+            return bad(
+                "--ppd",
+                "give resolutions of at least 6 particles per Dg".into(),
+            );
+        }
+        if self.variants.is_empty() {
+            return bad("--variants", "give at least one".into());
+        }
+        if self.samples < 2 {
+            return bad(
+                "--samples",
+                format!("at least 2 for error bars, got {}", self.samples),
+            );
+        }
+        if (self.impacts as usize) < SLOPE_WINDOW + 1 {
+            return bad(
+                "--impacts",
+                format!(
+                    "at least {} (the last-{SLOPE_WINDOW} slope), got {}",
+                    SLOPE_WINDOW + 1,
+                    self.impacts
+                ),
+            );
+        }
+        Ok(self.params.validate()?)
+    }
+
+    /// The first row of `rows` (from an earlier run being resumed) with other samples or
+    /// impacts than this study: such rows cannot be compared with the new ones.
+    pub fn resume_clash<'a>(&self, rows: &'a [SweepRow]) -> Option<&'a SweepRow> {
+        rows.iter()
+            .find(|r| r.samples != self.samples || r.impacts != self.impacts)
+    }
+
+    /// The (variant, resolution) points `done` does not hold yet, in run order.
+    pub fn plan(&self, done: &[SweepRow]) -> Vec<(Variant, f64)> {
+        let mut plan: Vec<(Variant, f64)> = Vec::new();
+        for (k, v) in self.variants.iter().enumerate() {
+            let list = if k == 0 || self.variant_ppd.is_empty() {
+                &self.ppd
+            } else {
+                &self.variant_ppd
+            };
+            plan.extend(list.iter().map(|p| (*v, *p)));
+        }
+        plan.retain(|(v, p)| {
+            !done
+                .iter()
+                .any(|r| r.variant == v.name() && r.particles_per_dg == *p)
+        });
+        plan
+    }
+
+    /// Runs the points `rows` lacks and appends their rows; `on_row` gets every row so far
+    /// after each point (the new one last), so a caller can save them and an interrupted sweep
+    /// keeps what it finished.
+    pub fn run<E: From<StudyError>>(
+        &self,
+        mut rows: Vec<SweepRow>,
+        progress: &(dyn Fn(SweepProgress) + Sync),
+        mut on_row: impl FnMut(&[SweepRow]) -> Result<(), E>,
+    ) -> Result<Vec<SweepRow>, E> {
+        self.validate()?;
+        for (variant, ppd) in self.plan(&rows) {
+            progress(SweepProgress::Point { variant, ppd });
+            let tick = || progress(SweepProgress::Impact);
+            let row = run_resolution(
+                &self.params,
+                variant,
+                ppd,
+                self.samples,
+                self.impacts,
+                self.seed,
+                &tick,
+            )
+            .map_err(|source| StudyError::Point {
+                variant: variant.name(),
+                ppd,
+                source,
+            })?;
+            rows.push(row);
+            on_row(&rows)?;
+        }
+        Ok(rows)
+    }
+
+    /// The chart's notes: the scene, and the cheapest setting within the finest's bars.
+    pub fn notes(&self, rows: &[SweepRow]) -> Vec<String> {
+        let p = &self.params;
+        let mut notes = vec![format!(
+            "Scene: {} at {}°, {} m/s, AISI 304; {} samples × {} impacts per point, seeds {}–{}; erosion = last-{SLOPE_WINDOW} slope.",
+            p.shape.name(),
+            p.angle_deg,
+            p.velocity_m_s,
+            self.samples,
+            self.impacts,
+            self.seed,
+            self.seed + self.samples as u64 - 1
+        )];
+        if let Some(best) = cheapest_within(rows) {
+            notes.push(format!(
+                "Cheapest within the finest's bars: {} at {} per Dg ({:.3} s per impact, {}).",
+                best.variant,
+                best.particles_per_dg,
+                Cost::of(rows).get(best),
+                Cost::of(rows).label()
+            ));
+        }
+        notes
+    }
+}
+
+impl SweepRow {
+    /// One line of the sweep's text table.
+    pub fn line(&self) -> String {
+        let r = self;
+        let mg = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{:.3}", x * 1e3));
+        format!(
+            "{:<24} {:>5} per Dg (depth {:.2} Dg)  {:>6} particles  {:>7.0} steps  {:>8.3} s/impact ({} CPU-s)  erosion {} ± {} (se {}) mg/g, {}/{} samples with loss  Hertz p0 error {}",
+            r.variant,
+            r.particles_per_dg,
+            r.surface_depth_dg,
+            r.particles,
+            r.steps_per_impact,
+            r.wall_per_impact_s,
+            r.cpu_per_impact_s.map_or("–".to_string(), |c| format!("{c:.3}")),
+            mg(r.erosion_mean),
+            mg(r.erosion_std),
+            mg(r.erosion_sem),
+            r.samples_with_loss,
+            r.samples,
+            r.hertz_p0_error
+                .map_or_else(|| r.hertz_failure.clone().unwrap_or_default(), |e| format!("{:.1} % at {} per radius", e * 100.0, r.hertz_per_radius))
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -308,13 +487,18 @@ mod tests {
         assert_eq!(Variant::parse("seed"), Ok(Variant::Seed));
         assert_eq!(Variant::parse("wendland_c2"), Ok(Variant::WendlandC2));
         assert_eq!(Variant::parse("cfl=0.5"), Ok(Variant::Cfl(0.5)));
-        assert!(Variant::parse("cfl=3").unwrap_err().contains("(0, 2]"));
+        assert!(Variant::parse("cfl=3")
+            .unwrap_err()
+            .to_string()
+            .contains("(0, 2]"));
         assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
         assert!(Variant::parse("absorbing=-1")
             .unwrap_err()
+            .to_string()
             .contains("number of layers > 0"));
         assert!(Variant::parse("cubic")
             .unwrap_err()
+            .to_string()
             .contains("unknown variant `cubic`"));
     }
 

@@ -1,10 +1,13 @@
-//! `grit verify`: the seed's contact benchmarks and the engine's own checks, as a table.
+//! `grit verify`: the contact benchmarks of Mohseni-Mofidi et al. 2022 and the engine's own
+//! checks, as a table.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
 use grit_sph::verification::{elastic_impact, hertz, hourglass, sliding, slope, CaseReport, Row};
+
+use crate::cli::output::say;
 
 /// A verification case run at the chosen resolution.
 type Case = Box<dyn Fn() -> Result<CaseReport, grit_sph::SimError>>;
@@ -59,14 +62,18 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         rep.extend(f().with_context(|| format!("case {name}"))?);
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rep.rows)?);
+        say!("{}", serde_json::to_string_pretty(&rep.rows)?);
     } else {
-        println!(
+        say!(
             "{:<42} {:<40} {:>12} {:>12} {:>10}  pass",
-            "case", "resolution", "value", "reference", "error"
+            "case",
+            "resolution",
+            "value",
+            "reference",
+            "error"
         );
         for r in &rep.rows {
-            println!(
+            say!(
                 "{:<42} {:<40} {:>12.5e} {:>12.5e} {:>10.3e}  {}",
                 r.case,
                 r.resolution,
@@ -76,16 +83,16 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 pass_label(r)
             );
         }
-        println!();
+        say!();
         for r in &rep.rows {
-            println!("{}: {}", r.case, r.note);
+            say!("{}: {}", r.case, r.note);
         }
     }
     if let Some(dir) = &a.charts {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for c in &rep.charts {
             let path = dir.join(format!("{}.svg", c.name));
-            crate::charts::line_chart(c, &path)?;
+            crate::cli::plot::line_chart(c, &path)?;
             eprintln!("wrote {}", path.display());
         }
     }

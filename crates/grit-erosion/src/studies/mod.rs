@@ -1,0 +1,46 @@
+//! Studies of the simulation's own choices, each run locally on the current rayon pool: when an
+//! impact may end (`settle`), where the numerics go unstable (`stability`), speed against
+//! accuracy over resolutions and numerical variants (`sweep`), and the timing of one impact
+//! (`bench`). They report progress through callbacks and return rows; writing files and
+//! drawing charts is the caller's.
+
+pub mod bench;
+pub mod settle;
+pub mod stability;
+pub mod sweep;
+
+pub use grit_sph::InputError;
+
+use crate::impact::ImpactParams;
+use crate::sample::SampleError;
+use crate::shapes::Shape;
+
+/// Why a study could not run or stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StudyError {
+    /// An option or the scene breaks a rule; names the option (e.g. `--cfl`) or scene field.
+    #[error(transparent)]
+    Invalid(#[from] InputError),
+    /// A sample of the study failed.
+    #[error(transparent)]
+    Sample(#[from] SampleError),
+    /// One point of the speed–accuracy sweep failed.
+    #[error("{variant} at {ppd} per Dg: {source}")]
+    Point {
+        /// Name of the variant.
+        variant: String,
+        /// Particles per grain diameter.
+        ppd: f64,
+        /// What failed.
+        source: SampleError,
+    },
+}
+
+/// The reference scene of the studies (hexagon, 100 m/s, AISI 304; Mohseni-Mofidi et al. 2022,
+/// section 4) at another angle and particle spacing.
+pub fn scene(angle_deg: f64, spacing_m: f64) -> ImpactParams {
+    ImpactParams {
+        spacing_m,
+        ..ImpactParams::paper(angle_deg, Shape::Hexagon)
+    }
+}

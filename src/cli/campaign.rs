@@ -1,0 +1,411 @@
+//! Commands on a campaign: `grit run` (the whole farm in this process) and the client
+//! commands against a coordinator: submit, status, results, cancel, retry-failed.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Args;
+use grit_erosion::campaign::CampaignSpec;
+use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_farm::embedded::{self, EmbeddedOptions, RunEvent};
+use grit_farm::worker::Stop;
+use grit_farm::{Client, ClientError};
+use indicatif::{MultiProgress, ProgressBar};
+use uuid::Uuid;
+
+use super::output::{say, write_json};
+use super::{on_signals, progress, read_token};
+
+/// `grit run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Campaign spec JSON (as in examples/); `-` reads standard input.
+    pub campaign: PathBuf,
+    /// Local workers (default: one per core, each with one engine thread, since samples
+    /// are independent and parallelise better than the threads inside one impact).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Engine threads per worker (default: cores / workers).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Output folder: grit.db (resumable) and results.json.
+    #[arg(long, default_value = "out/run")]
+    pub out: PathBuf,
+    /// Checkpoint every this many impacts.
+    #[arg(long, default_value_t = 5)]
+    pub checkpoint_every: u32,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Include every sample's per-impact series in results.json (as `results --raw`).
+    #[arg(long)]
+    pub raw: bool,
+}
+
+/// Where the coordinator is and how to authenticate, for client commands.
+#[derive(Args, Debug)]
+pub struct Remote {
+    /// Coordinator base URL.
+    #[arg(
+        long,
+        env = "GRIT_COORDINATOR",
+        default_value = "http://127.0.0.1:8080"
+    )]
+    pub coordinator: String,
+    /// Submit token.
+    #[arg(long, env = "GRIT_TOKEN", hide_env_values = true)]
+    pub token: Option<String>,
+    /// File holding the token.
+    #[arg(long, env = "GRIT_TOKEN_FILE")]
+    pub token_file: Option<PathBuf>,
+}
+
+impl Remote {
+    fn client(self) -> anyhow::Result<Client> {
+        let token = read_token(self.token, self.token_file, "token")?;
+        Ok(Client::new(&self.coordinator, token)?)
+    }
+}
+
+/// `grit submit`.
+#[derive(Args, Debug)]
+pub struct SubmitArgs {
+    /// Campaign spec JSON; `-` reads standard input.
+    pub file: PathBuf,
+    /// Idempotency key: submitting again with the same key returns the same campaign.
+    #[arg(long)]
+    pub idempotency_key: Option<String>,
+    #[command(flatten)]
+    remote: Remote,
+}
+
+/// `grit status`.
+#[derive(Args, Debug)]
+pub struct StatusArgs {
+    /// Campaign id; without it, every campaign is listed.
+    pub id: Option<String>,
+    /// Refresh with progress bars until the campaign ends.
+    #[arg(long)]
+    pub watch: bool,
+    /// Print the status JSON of the API.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    remote: Remote,
+}
+
+/// `grit results`.
+#[derive(Args, Debug)]
+pub struct ResultsArgs {
+    /// Campaign id.
+    pub id: String,
+    /// Write to this file instead of standard output.
+    #[arg(short = 'o', long)]
+    pub output: Option<PathBuf>,
+    /// Include every sample's per-impact series.
+    #[arg(long)]
+    pub raw: bool,
+    #[command(flatten)]
+    remote: Remote,
+}
+
+/// A campaign id and the coordinator: `grit cancel`, `grit retry-failed`.
+#[derive(Args, Debug)]
+pub struct IdArgs {
+    /// Campaign id.
+    pub id: String,
+    #[command(flatten)]
+    remote: Remote,
+}
+
+fn read_spec_text(path: &Path) -> anyhow::Result<String> {
+    if path == Path::new("-") {
+        let mut s = String::new();
+        std::io::Read::read_to_string(&mut std::io::stdin(), &mut s).context("stdin")?;
+        return Ok(s);
+    }
+    std::fs::read_to_string(path).with_context(|| path.display().to_string())
+}
+
+fn parse_id(s: &str) -> anyhow::Result<Uuid> {
+    s.parse()
+        .map_err(|_| anyhow::anyhow!("campaign id `{s}` is not a uuid"))
+}
+
+fn fmt_eta(s: Option<f64>) -> String {
+    s.map_or("–".into(), |s| {
+        indicatif::HumanDuration(Duration::from_secs_f64(s.max(0.0))).to_string()
+    })
+}
+
+fn fmt_state(s: &CampaignState) -> String {
+    format!("{s:?}").to_lowercase()
+}
+
+/// `grit run`: the campaign on this machine, a progress bar, results.json and its charts.
+pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
+    let text = read_spec_text(&a.campaign)?;
+    let spec = CampaignSpec::from_json(&text)
+        .and_then(|s| s.validate().map(|_| s))
+        .with_context(|| a.campaign.display().to_string())?;
+    let opts = EmbeddedOptions {
+        out: a.out.clone(),
+        workers: a
+            .workers
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        threads_per_worker: a.threads,
+        checkpoint_every: a.checkpoint_every.max(1),
+        raw: a.raw,
+    };
+    let stop = Stop::default();
+    on_signals(stop.clone());
+    let bar = progress::bar(0, "impacts", !a.quiet);
+    // Without a terminal (a log file, a batch job) the bar draws nothing: say the same in a
+    // plain line now and then, so long campaigns still show progress.
+    let plain = !a.quiet && !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let started = Instant::now();
+    let mut last_line: Option<Instant> = None;
+    let outcome = embedded::run(&spec, &opts, stop, |event| match event {
+        RunEvent::Started { impacts_total } => bar.set_length(impacts_total),
+        RunEvent::Status(status) => {
+            bar.set_position(status.impacts_done);
+            bar.set_message(run_message(status));
+            if plain && last_line.is_none_or(|t| t.elapsed() >= Duration::from_secs(30)) {
+                last_line = Some(Instant::now());
+                eprintln!(
+                    "[{:>6.0} s] {}/{} impacts  {}",
+                    started.elapsed().as_secs_f64(),
+                    status.impacts_done,
+                    status.impacts_total,
+                    bar.message()
+                );
+            }
+        }
+        RunEvent::Note(line) => bar.println(line),
+    })
+    .await?;
+    bar.finish();
+    let results_path = a.out.join("results.json");
+    write_json(&results_path, &outcome.results)?;
+    eprintln!(
+        "campaign {:?}; results in {}",
+        outcome.state,
+        results_path.display()
+    );
+    for c in &outcome.results.results.cells {
+        let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
+        say!(
+            "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}",
+            c.angle_deg,
+            c.shape,
+            c.samples,
+            fmt(c.erosion_mean),
+            fmt(c.erosion_std)
+        );
+    }
+    // Charts beside results.json (`grit plot` draws the same); a chart that fails leaves
+    // the results, already written, standing.
+    match grit_plot::plot_file(&results_path, &a.out) {
+        Ok(r) => eprintln!(
+            "{} chart files (PNG, SVG) in {}",
+            r.files.len(),
+            a.out.display()
+        ),
+        Err(e) => eprintln!("charts not written: {e}"),
+    }
+    Ok(match outcome.state {
+        CampaignState::Done => ExitCode::SUCCESS,
+        _ => ExitCode::from(1),
+    })
+}
+
+/// The bar's message while `grit run` runs: rate, ETA and jobs done.
+fn run_message(status: &CampaignStatus) -> String {
+    let rate = status
+        .rate_impacts_per_s
+        .map_or("rate –".to_string(), |r| format!("{:.3} impacts/s", r));
+    let eta = status.eta_s.map_or("ETA –".to_string(), |s| {
+        format!(
+            "ETA {}",
+            indicatif::HumanDuration(Duration::from_secs_f64(s))
+        )
+    });
+    let j = &status.jobs;
+    format!(
+        "{rate}  {eta}  jobs {}/{} done{}",
+        j.done,
+        j.done + j.queued + j.leased + j.failed + j.cancelled,
+        if j.failed > 0 {
+            format!(", {} failed", j.failed)
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// `grit submit`.
+pub async fn submit(a: SubmitArgs) -> anyhow::Result<ExitCode> {
+    let text = read_spec_text(&a.file)?;
+    let client = a.remote.client()?;
+    let created = client
+        .submit(&text, a.idempotency_key.as_deref())
+        .await
+        .map_err(|e| match e {
+            ClientError::Status { message, .. } => {
+                anyhow::anyhow!("{}: {message}", a.file.display())
+            }
+            other => other.into(),
+        })?;
+    eprintln!(
+        "{} campaign: {} jobs, {} impacts",
+        if created.created {
+            "submitted"
+        } else {
+            "already submitted"
+        },
+        created.jobs,
+        created.impacts_total
+    );
+    say!("{}", created.id);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `grit status`: every campaign, one campaign, or one watched to its end.
+pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
+    let json = a.json;
+    let client = a.remote.client()?;
+    let Some(id) = a.id.as_deref() else {
+        let list = client.list().await?;
+        if json {
+            say!("{}", serde_json::to_string_pretty(&list)?);
+        } else {
+            for c in list {
+                say!(
+                    "{}  {:<9}  {}/{} impacts  {}",
+                    c.id,
+                    fmt_state(&c.state),
+                    c.impacts_done,
+                    c.impacts_total,
+                    c.name.unwrap_or_default()
+                );
+            }
+        }
+        return Ok(ExitCode::SUCCESS);
+    };
+    let id = parse_id(id)?;
+    if a.watch {
+        return watch(&client, id).await;
+    }
+    let s = client.status(id).await?;
+    if json {
+        say!("{}", serde_json::to_string_pretty(&s)?);
+    } else {
+        say!(
+            "{}  {}  {}/{} impacts  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}",
+            s.id,
+            fmt_state(&s.state),
+            s.impacts_done,
+            s.impacts_total,
+            s.jobs.queued,
+            s.jobs.leased,
+            s.jobs.done,
+            s.jobs.failed,
+            s.jobs.cancelled,
+            s.rate_impacts_per_s.map_or("–".into(), |r| format!("{r:.3}/s")),
+            fmt_eta(s.eta_s)
+        );
+        if let Some(e) = s.last_error {
+            say!(
+                "last error (cell {}, sample {}): {}",
+                e.cell,
+                e.sample,
+                e.error
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `grit status ID --watch`: a bar for the campaign and one per cell, refreshed every 2 s.
+async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
+    let multi = MultiProgress::new();
+    let total = multi.add(progress::bar(0, "all cells", true));
+    let mut cells: Vec<ProgressBar> = Vec::new();
+    loop {
+        let s = match client.status(id).await {
+            Ok(s) => s,
+            Err(e) if e.is_transient() => {
+                total.set_message(format!("(coordinator unreachable: {e})"));
+                tokio::time::sleep(Duration::from_secs(2)).await;
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        total.set_length(s.impacts_total);
+        total.set_position(s.impacts_done);
+        total.set_message(format!(
+            "{}  rate {}  ETA {}",
+            fmt_state(&s.state),
+            s.rate_impacts_per_s
+                .map_or("–".into(), |r| format!("{r:.3}/s")),
+            fmt_eta(s.eta_s)
+        ));
+        while cells.len() < s.cells.len() {
+            let c = &s.cells[cells.len()];
+            let prefix = format!("{:.1}° {}", c.angle_deg, c.shape);
+            cells.push(multi.add(progress::bar(c.impacts_total, &prefix, true)));
+        }
+        for (bar, c) in cells.iter().zip(&s.cells) {
+            bar.set_position(c.impacts_done);
+            bar.set_message(format!("{}/{} samples", c.samples_done, c.samples_total));
+        }
+        if s.state.is_final() {
+            total.finish();
+            for b in &cells {
+                b.finish();
+            }
+            if let Some(e) = s.last_error {
+                say!(
+                    "last error (cell {}, sample {}): {}",
+                    e.cell,
+                    e.sample,
+                    e.error
+                );
+            }
+            return Ok(ExitCode::SUCCESS);
+        }
+        tokio::time::sleep(Duration::from_secs(2)).await;
+    }
+}
+
+/// `grit results`: the aggregated results, to a file or standard output.
+pub async fn results(a: ResultsArgs) -> anyhow::Result<ExitCode> {
+    let id = parse_id(&a.id)?;
+    let v = a.remote.client()?.results_value(id, a.raw).await?;
+    match &a.output {
+        Some(p) => {
+            write_json(p, &v)?;
+            eprintln!("results written to {}", p.display());
+        }
+        None => say!("{}", serde_json::to_string_pretty(&v)?),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `grit cancel`.
+pub async fn cancel(a: IdArgs) -> anyhow::Result<ExitCode> {
+    let id = parse_id(&a.id)?;
+    let r = a.remote.client()?.cancel(id).await?;
+    say!("cancelled {id}: {} jobs stopped", r.jobs);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `grit retry-failed`.
+pub async fn retry_failed(a: IdArgs) -> anyhow::Result<ExitCode> {
+    let id = parse_id(&a.id)?;
+    let r = a.remote.client()?.retry_failed(id).await?;
+    say!("{id}: {} failed jobs queued again", r.jobs);
+    Ok(ExitCode::SUCCESS)
+}

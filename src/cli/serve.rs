@@ -1,0 +1,165 @@
+//! The farm's long-running processes: `grit serve` (the coordinator) and `grit work` (a worker).
+
+use std::io::Write;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{bail, Context};
+use clap::Args;
+use grit_farm::server::{self, Config};
+use grit_farm::worker::{self, Stop, WorkerOptions};
+use grit_farm::{Client, Store};
+
+use super::output::say;
+use super::{on_signals, read_token};
+
+/// `grit serve`.
+#[derive(Args, Debug)]
+pub struct ServeArgs {
+    /// SQLite database file (created if missing). Keep it on a local disk, not a network
+    /// filesystem: SQLite's locking needs one.
+    #[arg(long, env = "GRIT_DB", default_value = "grit.db")]
+    pub db: PathBuf,
+    /// Address to listen on; port 0 picks a free port (the bound address is printed).
+    #[arg(long, env = "GRIT_LISTEN", default_value = "127.0.0.1:8080")]
+    pub listen: String,
+    /// Lease length in seconds; a worker that misses heartbeats this long loses its job.
+    #[arg(long, env = "GRIT_LEASE_TTL_S", default_value_t = 120.0)]
+    pub lease_ttl_s: f64,
+    /// Lost or failed leases after which a job stays failed.
+    #[arg(long, env = "GRIT_MAX_ATTEMPTS", default_value_t = 3)]
+    pub max_attempts: u32,
+    /// Token for submitting and reading campaigns.
+    #[arg(long, env = "GRIT_SUBMIT_TOKEN", hide_env_values = true)]
+    pub submit_token: Option<String>,
+    /// File holding the submit token.
+    #[arg(long, env = "GRIT_SUBMIT_TOKEN_FILE")]
+    pub submit_token_file: Option<PathBuf>,
+    /// Token for workers.
+    #[arg(long, env = "GRIT_WORKER_TOKEN", hide_env_values = true)]
+    pub worker_token: Option<String>,
+    /// File holding the worker token.
+    #[arg(long, env = "GRIT_WORKER_TOKEN_FILE")]
+    pub worker_token_file: Option<PathBuf>,
+    /// Largest campaign spec accepted, bytes (larger gets 413).
+    #[arg(long, default_value_t = server::DEFAULT_SUBMIT_LIMIT)]
+    pub max_spec_bytes: usize,
+    /// Largest worker request, bytes (heartbeats carry checkpoints).
+    #[arg(long, default_value_t = server::DEFAULT_WORKER_LIMIT)]
+    pub max_worker_bytes: usize,
+    /// Serve without tokens on a non-loopback address (anyone who can connect may submit
+    /// and report results).
+    #[arg(long)]
+    pub insecure_no_auth: bool,
+}
+
+/// `grit work`.
+#[derive(Args, Debug)]
+pub struct WorkArgs {
+    /// Coordinator base URL.
+    #[arg(
+        long,
+        env = "GRIT_COORDINATOR",
+        default_value = "http://127.0.0.1:8080"
+    )]
+    pub coordinator: String,
+    /// Worker token.
+    #[arg(long, env = "GRIT_TOKEN", hide_env_values = true)]
+    pub token: Option<String>,
+    /// File holding the worker token.
+    #[arg(long, env = "GRIT_TOKEN_FILE")]
+    pub token_file: Option<PathBuf>,
+    /// Engine threads (rayon pool size); default all cores.
+    #[arg(long, env = "GRIT_THREADS")]
+    pub threads: Option<usize>,
+    /// Upload a checkpoint every this many impacts.
+    #[arg(long, default_value_t = 5)]
+    pub checkpoint_every: u32,
+    /// Name reported to the coordinator (default host:pid).
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Exit when the queue is empty instead of waiting for more jobs.
+    #[arg(long)]
+    pub exit_when_idle: bool,
+    /// Seconds between claims while the queue is empty.
+    #[arg(long, default_value_t = 5.0)]
+    pub poll_s: f64,
+}
+
+/// `grit serve`: the coordinator until SIGTERM or SIGINT.
+pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
+    if !(a.lease_ttl_s.is_finite() && a.lease_ttl_s >= 0.5) {
+        bail!("--lease-ttl-s must be at least 0.5, got {}", a.lease_ttl_s);
+    }
+    let submit_token = read_token(a.submit_token, a.submit_token_file, "submit-token")?;
+    let worker_token = read_token(a.worker_token, a.worker_token_file, "worker-token")?;
+    let loopback = a
+        .listen
+        .parse::<SocketAddr>()
+        .is_ok_and(|s| s.ip().is_loopback())
+        || a.listen.starts_with("localhost:");
+    let missing = submit_token.expose().is_none() || worker_token.expose().is_none();
+    if missing && !loopback && !a.insecure_no_auth {
+        bail!("set GRIT_SUBMIT_TOKEN and GRIT_WORKER_TOKEN (or --*-token-file) before listening on a non-loopback address, or pass --insecure-no-auth");
+    }
+    if missing {
+        tracing::warn!("a token is not set: its endpoints accept anyone who can connect");
+    }
+    let store = Store::open(
+        &a.db,
+        Duration::from_secs_f64(a.lease_ttl_s),
+        a.max_attempts,
+    )
+    .await
+    .with_context(|| format!("--db {}", a.db.display()))?;
+    let config = Config {
+        submit_token,
+        worker_token,
+        submit_limit: a.max_spec_bytes,
+        worker_limit: a.max_worker_bytes,
+    };
+    let running = server::start(&a.listen, store, config)
+        .await
+        .with_context(|| format!("--listen {}", a.listen))?;
+    // Tests and scripts read the bound address (port 0 resolved) from this line.
+    say!("grit coordinator listening on http://{}", running.addr);
+    let _ = std::io::stdout().flush();
+    tracing::info!(addr = %running.addr, db = %a.db.display(), "coordinator started");
+    let stop = Stop::default();
+    on_signals(stop.clone());
+    while !stop.sleep(Duration::from_secs(3600)).await {}
+    running.stop().await;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `grit work`: leases and runs jobs until stopped (or idle with `--exit-when-idle`).
+pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
+    let token = read_token(a.token, a.token_file, "token")?;
+    let client = Client::new(&a.coordinator, token)?;
+    if a.checkpoint_every == 0 {
+        bail!("--checkpoint-every must be at least 1");
+    }
+    if !(a.poll_s.is_finite() && a.poll_s > 0.0) {
+        bail!("--poll-s must be > 0");
+    }
+    let opts = WorkerOptions {
+        name: a.name.unwrap_or_else(worker::default_name),
+        threads: a.threads,
+        checkpoint_every: a.checkpoint_every,
+        exit_when_idle: a.exit_when_idle,
+        idle_poll: Duration::from_secs_f64(a.poll_s),
+        ..WorkerOptions::default()
+    };
+    let stop = Stop::default();
+    on_signals(stop.clone());
+    tracing::info!(coordinator = %client.base(), name = %opts.name, "worker started");
+    let summary = worker::run(client, opts, stop).await?;
+    tracing::info!(
+        jobs = summary.jobs_done,
+        impacts = summary.impacts,
+        "worker stopped"
+    );
+    Ok(ExitCode::SUCCESS)
+}
