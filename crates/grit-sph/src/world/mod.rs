@@ -16,8 +16,8 @@ use crate::contact::{self, ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::kernel::Kernel;
 use crate::math::{cross, omega_cross, outer, rotate, Matrix, Vector};
-use crate::neighbours::{self, NeighbourLists};
-use crate::particles::{von_mises, Particles, BOUNDARY, KINEMATIC};
+use crate::neighbours::{self, body_pairs, NeighbourLists, Pair, PairCache};
+use crate::particles::{von_mises, Particles, KINEMATIC};
 use crate::physics;
 use crate::timers::{Stage, Timers};
 
@@ -59,11 +59,8 @@ type Hit = (Vector, usize, f64, f64);
 /// Scratch arrays rebuilt every step (not part of a checkpoint).
 #[derive(Debug, Clone, Default)]
 struct Scratch {
-    /// Same-body pairs of this step with their kernel values, in each particle's slice of the
-    /// neighbour rows (first `pair_count[i]` entries used): computed once in the kernel sums,
-    /// read by the rates and the forces, so each pair's kernel is evaluated once per step.
-    pairs: Vec<Pair>,
-    pair_count: Vec<u32>,
+    /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
+    pairs: PairCache,
     /// Particle volumes m/ρ at the kernel sums, computed once instead of once per pair; valid
     /// until the stress stage updates ρ.
     vol: Vec<f64>,
@@ -204,79 +201,26 @@ impl World {
             .collect()
     }
 
-    /// Rebuilds neighbour lists: deformable particles see their own body and the primary
-    /// boundary particles they can touch; rigid secondary boundary particles see their primaries.
-    fn rebuild_neighbours(&mut self) {
-        if self.settings.cell_order {
-            self.sort_by_cell();
-        }
-        let nb = self.bodies.len();
-        // relation[a * nb + b]: can a particle of body a list one of body b?
-        let mut relation = vec![false; nb * nb];
-        let mut is_secondary = vec![false; nb];
-        let mut is_primary = vec![false; nb];
-        for (a, body) in self.bodies.iter().enumerate() {
-            if !body.is_rigid() {
-                relation[a * nb + a] = true;
-            }
-        }
-        for c in &self.contacts {
-            relation[c.secondary * nb + c.primary] = true;
-            is_secondary[c.secondary] = true;
-            is_primary[c.primary] = true;
-        }
-        let p = &self.particles;
-        let n = p.len();
-        let rigid: Vec<bool> = self.bodies.iter().map(|b| b.is_rigid()).collect();
-        let searcher: Vec<bool> = (0..n)
-            .map(|i| {
-                let b = p.body[i] as usize;
-                !rigid[b] || (is_secondary[b] && p.flags[i] & BOUNDARY != 0)
-            })
-            .collect();
-        let candidate: Vec<bool> = (0..n)
-            .map(|i| {
-                let b = p.body[i] as usize;
-                !rigid[b] || (is_primary[b] && p.flags[i] & BOUNDARY != 0)
-            })
-            .collect();
-        let radius = self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m;
-        let body = &p.body;
-        self.nbrs = neighbours::build(&p.pos, &searcher, &candidate, radius, |i, j| {
-            relation[body[i] as usize * nb + body[j] as usize]
-        });
-        self.x_build = p.pos.clone();
-        self.nbrs_valid = true;
+    /// Reach of the neighbour lists, and the cell size of the cell order: the kernel support
+    /// plus the Verlet skin.
+    fn neighbour_reach(&self) -> f64 {
+        self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m
     }
 
-    /// Reorders the particles by body, then deformable ones by the Z-order (Morton) index of
-    /// their neighbour-search cell, ties by current index; rigid bodies keep their order. Every
-    /// per-particle array moves with them (`Settings::cell_order`).
-    fn sort_by_cell(&mut self) {
-        let p = &self.particles;
-        let n = p.len();
-        if n == 0 {
-            return;
-        }
-        let cell = self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m;
-        let lo = p.pos.iter().fold(p.pos[0], |a, x| a.inf(x));
-        let deformable: Vec<bool> = self.bodies.iter().map(|b| !b.is_rigid()).collect();
-        let key = |i: usize| -> u64 {
-            if !deformable[p.body[i] as usize] {
-                return 0;
+    /// Rebuilds neighbour lists (`neighbours::build_for_bodies`), first putting the particles in
+    /// cell order where `Settings::cell_order` asks for it.
+    fn rebuild_neighbours(&mut self) {
+        if self.settings.cell_order {
+            let cell = self.neighbour_reach();
+            if let Some(order) = neighbours::cell_order(&self.particles, &self.bodies, cell) {
+                self.reorder_particles(&order);
             }
-            let c = (p.pos[i] - lo) / cell;
-            // Cells past 2^31 along an axis (a particle flung far off) share the last one.
-            let ix = c.x.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
-            let iy = c.y.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
-            morton(ix, iy)
-        };
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by_key(|&i| (p.body[i], key(i), i));
-        if order.iter().enumerate().all(|(k, &i)| k == i) {
-            return;
         }
-        self.reorder_particles(&order);
+        let radius = self.neighbour_reach();
+        self.nbrs =
+            neighbours::build_for_bodies(&self.particles, &self.bodies, &self.contacts, radius);
+        self.x_build = self.particles.pos.clone();
+        self.nbrs_valid = true;
     }
 
     fn needs_rebuild(&self) -> bool {
@@ -284,12 +228,7 @@ impl World {
             return true;
         }
         let half = 0.5 * self.settings.skin_over_dx * self.settings.spacing_m;
-        let lim = half * half;
-        self.particles
-            .pos
-            .par_iter()
-            .zip(&self.x_build)
-            .any(|(x, x0)| (x - x0).norm_squared() > lim)
+        neighbours::stale(&self.particles.pos, &self.x_build, half)
     }
 
     /// Stable time step: CFL on the material signal speed plus particle speed, and the
@@ -381,7 +320,7 @@ impl World {
         }
         let dt = self.dt;
         let bc = self.body_consts();
-        let ready = self.nbrs_valid && self.scratch.pair_count.len() == self.particles.len();
+        let ready = self.nbrs_valid && self.scratch.pairs.count.len() == self.particles.len();
         if stage != Stage::Neighbours && !ready {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
             self.rebuild_neighbours();
@@ -438,7 +377,7 @@ impl World {
                 .with_max_len(MAX_LEN)
                 .map(|(m, r)| m / r),
         );
-        let mut buf = std::mem::take(&mut self.scratch.pairs);
+        let mut buf = std::mem::take(&mut self.scratch.pairs.pairs);
         // Rows are overwritten before they are read: grow, never clear (a memset per step).
         if buf.len() < nl.list.len() {
             buf.resize(nl.list.len(), Pair::default());
@@ -482,15 +421,15 @@ impl World {
             })
             .collect();
         let s = &mut self.scratch;
-        s.pairs = buf;
+        s.pairs.pairs = buf;
         s.vol = vol;
         s.shepard.clear();
         s.lcorr.clear();
-        s.pair_count.clear();
+        s.pairs.count.clear();
         for (g, l, c) in out {
             s.shepard.push(g);
             s.lcorr.push(l);
-            s.pair_count.push(c);
+            s.pairs.count.push(c);
         }
     }
 
@@ -506,12 +445,12 @@ impl World {
             .with_max_len(MAX_LEN)
             .map(|i| {
                 let bi = p.body[i];
-                if !bc[bi as usize].deformable || pairs.pair_count[i] < MIN_SUPPORT_NEIGHBOURS {
+                if !bc[bi as usize].deformable || pairs.pairs.count[i] < MIN_SUPPORT_NEIGHBOURS {
                     return Matrix::zeros();
                 }
                 let vi = p.vel[i];
                 let mut gv = Matrix::zeros();
-                for &Pair { j, xij, r, dw, .. } in pairs.cached(nl, i) {
+                for &Pair { j, xij, r, dw, .. } in pairs.pairs.of(nl, i) {
                     if r == 0.0 {
                         continue;
                     }
@@ -635,14 +574,14 @@ impl World {
                 if !c.deformable || p.flags[i] & KINEMATIC != 0 {
                     return (Vector::zeros(), 0.0);
                 }
-                if cache.pair_count[i] < MIN_SUPPORT_NEIGHBOURS {
+                if cache.pairs.count[i] < MIN_SUPPORT_NEIGHBOURS {
                     return (g, 0.0);
                 }
                 let vi = p.vel[i];
                 let voli = p.mass[i] / p.rho[i];
                 let mut a = Vector::zeros();
                 let mut fhg = Vector::zeros();
-                for &Pair { j, xij, r, w, dw } in cache.cached(nl, i) {
+                for &Pair { j, xij, r, w, dw } in cache.pairs.of(nl, i) {
                     if r == 0.0 {
                         continue;
                     }
@@ -1072,66 +1011,6 @@ fn mls_density(p: &Particles, nl: &NeighbourLists, k: &Kernel, i: usize) -> Opti
     let beta = a.try_inverse()?.column(0).into_owned();
     let rho = beta.dot(&b);
     (rho.is_finite() && rho > 0.0).then_some(rho)
-}
-
-impl Scratch {
-    /// The cached same-body pairs of particle `i` (filled by the kernel sums this step).
-    #[inline]
-    fn cached<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [Pair] {
-        let s = nl.start[i] as usize;
-        &self.pairs[s..s + self.pair_count[i] as usize]
-    }
-}
-
-/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr.
-#[derive(Debug, Clone, Copy, Default)]
-struct Pair {
-    j: usize,
-    xij: Vector,
-    r: f64,
-    w: f64,
-    dw: f64,
-}
-
-/// The same-body neighbours of `i` with their kernel values: the loop every SPH sum of the
-/// deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
-fn body_pairs<'a>(
-    p: &'a Particles,
-    nl: &'a NeighbourLists,
-    k: &'a Kernel,
-    i: usize,
-) -> impl Iterator<Item = Pair> + 'a {
-    let (bi, xi) = (p.body[i], p.pos[i]);
-    let r2max = k.radius() * k.radius();
-    nl.of(i)
-        .iter()
-        .map(|&j| j as usize)
-        .filter(move |&j| p.body[j] == bi)
-        .filter_map(move |j| {
-            let xij = xi - p.pos[j];
-            let r2 = xij.norm_squared();
-            // The lists reach a skin beyond the support; those pairs would add exact zeros.
-            if r2 >= r2max {
-                return None;
-            }
-            let r = r2.sqrt();
-            let (w, dw) = k.w_dw(r);
-            Some(Pair { j, xij, r, w, dw })
-        })
-}
-
-/// Interleaves the bits of `x` and `y` (x in the even bits): the Z-order curve index of a cell.
-fn morton(x: u32, y: u32) -> u64 {
-    fn spread(v: u32) -> u64 {
-        let mut v = v as u64;
-        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
-        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
-        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
-        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
-        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
-        v
-    }
-    spread(x) | (spread(y) << 1)
 }
 
 /// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a
