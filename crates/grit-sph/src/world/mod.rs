@@ -5,6 +5,7 @@ mod build;
 mod diagnostics;
 mod settings;
 
+pub use crate::stages::{HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 pub use diagnostics::{Energy, NumericalWork};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
 
@@ -15,42 +16,11 @@ use crate::body::{Absorber, Body, BodyKind, Motion};
 use crate::contact::{self, ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::kernel::Kernel;
-use crate::math::{cross, omega_cross, outer, rotate, Matrix, Vector};
+use crate::math::{cross, omega_cross, rotate, Matrix, Vector};
 use crate::neighbours::{self, body_pairs, NeighbourLists, Pair, PairCache};
-use crate::particles::{von_mises, Particles, KINEMATIC};
-use crate::physics;
+use crate::particles::{Particles, KINEMATIC};
+use crate::stages::{self, BodyConst, KernelSums, ParTasks, SphView};
 use crate::timers::{Stage, Timers};
-
-/// Smallest number of particles one rayon task takes: below it the per-task overhead costs more
-/// than the work (small verification scenes ran slower on 2 threads than on 1 without it).
-const MIN_LEN: usize = 64;
-
-/// Largest number of particles one rayon task takes. The work of a step is uneven along the
-/// index (the grain's particles and the free surface do less, the few hundred particles under
-/// the grain do the contact), and rayon's adaptive splitting can leave a few large tasks, so one
-/// thread sat idle while the other finished. Tasks of at most 256 particles let the idle thread
-/// steal: the full step's speed-up from 1 to 2 threads rose from 1.66 to 1.86
-/// (median of 4–5, `cargo run --release -p grit-erosion --example stage_scaling`).
-const MAX_LEN: usize = 256;
-
-/// A deformable particle with fewer same-body neighbours inside the kernel support than this is
-/// a fragment torn off its body: its kernel sums no longer describe a continuum (the Shepard
-/// normalisation of eq. 9 divides by a near-empty sum and blows up), so it flies ballistically,
-/// keeping its stress, until it rejoins material. A particle inside a body has about 44.
-pub const MIN_SUPPORT_NEIGHBOURS: u32 = 6;
-
-/// Pair separation (in h) below which the hourglass force of eq. 16 stops growing as 1/r².
-pub const HG_MIN_SEPARATION_H: f64 = 0.4;
-
-/// Per-body constants the stages need, looked up by particle.
-#[derive(Debug, Clone, Copy, Default)]
-struct BodyConst {
-    deformable: bool,
-    bulk: f64,
-    shear: f64,
-    youngs: f64,
-    sound: f64,
-}
 
 /// One secondary particle's contact: (force on it, nearest primary particle, distance,
 /// dashpot work).
@@ -61,13 +31,13 @@ type Hit = (Vector, usize, f64, f64);
 struct Scratch {
     /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
     pairs: PairCache,
-    /// Particle volumes m/ρ at the kernel sums, computed once instead of once per pair; valid
-    /// until the stress stage updates ρ.
-    vol: Vec<f64>,
-    shepard: Vec<f64>,
-    lcorr: Vec<Matrix>,
+    /// Volumes, Shepard sums and correction matrices of the kernel sums.
+    sums: KernelSums,
+    /// Velocity gradients of the rates.
     gradv: Vec<Matrix>,
+    /// Accelerations of the forces.
     acc: Vec<Vector>,
+    /// Contact force on each particle.
     contact_force: Vec<Vector>,
 }
 
@@ -185,22 +155,6 @@ impl World {
         self.nbrs.pairs()
     }
 
-    fn body_consts(&self) -> Vec<BodyConst> {
-        self.bodies
-            .iter()
-            .map(|b| match b.material() {
-                Some(m) => BodyConst {
-                    deformable: true,
-                    bulk: m.bulk_modulus(),
-                    shear: m.shear_modulus(),
-                    youngs: m.youngs_modulus_pa,
-                    sound: m.sound_speed(),
-                },
-                None => BodyConst::default(),
-            })
-            .collect()
-    }
-
     /// Reach of the neighbour lists, and the cell size of the cell order: the kernel support
     /// plus the Verlet skin.
     fn neighbour_reach(&self) -> f64 {
@@ -234,13 +188,12 @@ impl World {
     /// Stable time step: CFL on the material signal speed plus particle speed, and the
     /// contact springs' period.
     fn compute_dt(&self) -> f64 {
-        let bc = self.body_consts();
+        let bc = stages::body_consts(&self.bodies);
         let p = &self.particles;
         let h = self.kernel.h;
         let smax = (0..p.len())
             .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
+            .par_tasks()
             .filter(|&i| bc[p.body[i] as usize].deformable)
             .map(|i| bc[p.body[i] as usize].sound + p.vel[i].norm())
             .reduce(|| 0.0, f64::max);
@@ -286,7 +239,7 @@ impl World {
         }
         let dt = self.dt;
         let n = self.particles.len();
-        let bc = self.body_consts();
+        let bc = stages::body_consts(&self.bodies);
 
         let mut timers = std::mem::take(&mut self.timers);
         if self.needs_rebuild() {
@@ -319,7 +272,7 @@ impl World {
             self.dt = self.compute_dt();
         }
         let dt = self.dt;
-        let bc = self.body_consts();
+        let bc = stages::body_consts(&self.bodies);
         let ready = self.nbrs_valid && self.scratch.pairs.count.len() == self.particles.len();
         if stage != Stage::Neighbours && !ready {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
@@ -360,270 +313,62 @@ impl World {
         Ok(self.steps - s0)
     }
 
-    /// Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator) and Bonet–Lok matrices L_i (eq. 8).
+    /// What the SPH sums of the stages read.
+    fn sph<'a>(&'a self, bc: &'a [BodyConst]) -> SphView<'a> {
+        SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        }
+    }
+
     fn kernel_sums(&mut self, bc: &[BodyConst]) {
-        let p = &self.particles;
-        let nl = &self.nbrs;
-        let k = &self.kernel;
-        let w0 = k.w(0.0);
-        let n = p.len();
-        let mut vol = std::mem::take(&mut self.scratch.vol);
-        vol.clear();
-        vol.par_extend(
-            p.mass
-                .par_iter()
-                .zip(&p.rho)
-                .with_min_len(MIN_LEN)
-                .with_max_len(MAX_LEN)
-                .map(|(m, r)| m / r),
-        );
-        let mut buf = std::mem::take(&mut self.scratch.pairs.pairs);
-        // Rows are overwritten before they are read: grow, never clear (a memset per step).
-        if buf.len() < nl.list.len() {
-            buf.resize(nl.list.len(), Pair::default());
-        }
-        // One mutable slice per particle, so the rows fill in parallel, each by its own owner.
-        let mut rows: Vec<&mut [Pair]> = Vec::with_capacity(n);
-        let mut rest = buf.as_mut_slice();
-        for i in 0..n {
-            let (row, tail) = rest.split_at_mut(nl.of(i).len());
-            rows.push(row);
-            rest = tail;
-        }
-        let out: Vec<(f64, Matrix, u32)> = rows
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
-            .enumerate()
-            .map(|(i, row)| {
-                let bi = p.body[i];
-                if !bc[bi as usize].deformable {
-                    return (1.0, Matrix::identity(), 0);
-                }
-                let mut g = p.mass[i] / p.rho[i] * w0;
-                let mut m = Matrix::zeros();
-                let mut cnt = 0;
-                for pair in body_pairs(p, nl, k, i) {
-                    // Listed within the skin but outside the support: contributes nothing.
-                    if pair.w == 0.0 && pair.dw == 0.0 {
-                        continue;
-                    }
-                    let vj = vol[pair.j];
-                    g += vj * pair.w;
-                    if pair.r > 0.0 {
-                        let grad = pair.xij * (pair.dw / pair.r);
-                        m += outer(-pair.xij, grad) * vj;
-                    }
-                    row[cnt] = pair;
-                    cnt += 1;
-                }
-                (g, correction(m), cnt as u32)
-            })
-            .collect();
-        let s = &mut self.scratch;
-        s.pairs.pairs = buf;
-        s.vol = vol;
-        s.shepard.clear();
-        s.lcorr.clear();
-        s.pairs.count.clear();
-        for (g, l, c) in out {
-            s.shepard.push(g);
-            s.lcorr.push(l);
-            s.pairs.count.push(c);
-        }
+        let s = SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        };
+        stages::kernel_sums(s, &mut self.scratch.pairs, &mut self.scratch.sums);
     }
 
-    /// Velocity gradient with the corrected kernel gradient (eq. 15, 7).
     fn rates(&mut self, bc: &[BodyConst]) {
-        let p = &self.particles;
-        let nl = &self.nbrs;
-        let lc = &self.scratch.lcorr;
-        let pairs = &self.scratch;
-        let out: Vec<Matrix> = (0..p.len())
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
-            .map(|i| {
-                let bi = p.body[i];
-                if !bc[bi as usize].deformable || pairs.pairs.count[i] < MIN_SUPPORT_NEIGHBOURS {
-                    return Matrix::zeros();
-                }
-                let vi = p.vel[i];
-                let mut gv = Matrix::zeros();
-                for &Pair { j, xij, r, dw, .. } in pairs.pairs.of(nl, i) {
-                    if r == 0.0 {
-                        continue;
-                    }
-                    gv += outer(p.vel[j] - vi, xij * (dw / r)) * pairs.vol[j];
-                }
-                gv * lc[i].transpose()
-            })
-            .collect();
-        self.scratch.gradv = out;
+        let gradv =
+            stages::velocity_gradients(self.sph(bc), &self.scratch.pairs, &self.scratch.sums);
+        self.scratch.gradv = gradv;
     }
 
-    /// Continuity (eq. 5 as ρ̇ = −ρ tr ∇v), Jaumann rate (eq. 13), radial return with Johnson–Cook
-    /// yield (eq. 18), adiabatic heating, damage (eqs. 19–20), and the deformation gradient the
-    /// hourglass stiffness compares against.
     fn stress(&mut self, bc: &[BodyConst], dt: f64) {
-        let gv = &self.scratch.gradv;
-        let bodies = &self.bodies;
         let beta = self.settings.taylor_quinney;
-        let p = &mut self.particles;
-        let plastic_work: f64 = p
-            .rho
-            .par_iter_mut()
-            .zip(p.sdev.par_iter_mut())
-            .zip(p.eps_p.par_iter_mut())
-            .zip(p.eps_p_rate.par_iter_mut())
-            .zip(p.temp.par_iter_mut())
-            .zip(p.damage.par_iter_mut())
-            .zip(p.def_grad.par_iter_mut())
-            .zip(p.body.par_iter())
-            .zip(p.mass.par_iter())
-            .zip(p.rho0.par_iter())
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
-            .enumerate()
-            .map(
-                |(i, (((((((((rho, s), ep), epr), temp), dmg), fdef), &b), &m), &rho0))| {
-                    let c = bc[b as usize];
-                    if !c.deformable {
-                        return 0.0;
-                    }
-                    let l = gv[i];
-                    let d = (l + l.transpose()) * 0.5;
-                    let w = (l - l.transpose()) * 0.5;
-                    let trd = d.trace();
-                    *rho *= 1.0 - dt * trd;
-                    *fdef += l * *fdef * dt;
-                    let dev = d - Matrix::identity() * (trd / 3.0);
-                    let s_trial = *s + (dev * (2.0 * c.shear) + w * *s - *s * w) * dt;
-                    let mat = bodies[b as usize]
-                        .material()
-                        .expect("deformable body has a material");
-                    match &mat.plasticity {
-                        None => {
-                            *s = s_trial;
-                            0.0
-                        }
-                        Some(jc) => {
-                            let r = physics::radial_return(s_trial, c.shear, jc, *ep, dt, *temp);
-                            *s = r.sdev;
-                            *epr = r.d_eps / dt;
-                            if r.d_eps > 0.0 {
-                                let wp = r.sigma_y * r.d_eps; // plastic work per volume
-                                if let Some(dm) = &mat.damage {
-                                    let seq = von_mises(&r.sdev);
-                                    let pr = c.bulk * (*rho / rho0 - 1.0);
-                                    let triax = if seq > 0.0 { -pr / seq } else { 0.0 };
-                                    let ef = physics::fracture_strain(dm, jc, triax, *epr, *temp);
-                                    *dmg += r.d_eps / ef;
-                                }
-                                *ep += r.d_eps;
-                                *temp += beta * wp / (*rho * mat.heat_capacity_j_kgk);
-                                wp * m / *rho
-                            } else {
-                                0.0
-                            }
-                        }
-                    }
-                },
-            )
-            .collect::<Vec<f64>>()
-            .iter()
-            .sum();
+        let plastic_work = stages::stress(
+            &mut self.particles,
+            &self.bodies,
+            bc,
+            &self.scratch.gradv,
+            beta,
+            dt,
+        );
         self.work.plastic -= plastic_work;
     }
 
-    /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9), the
-    /// hourglass force (eq. 16) and gravity.
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
-        let p = &self.particles;
-        let nl = &self.nbrs;
-        let k = &self.kernel;
-        let alpha = self.settings.hourglass;
-        let g = self.settings.gravity_m_s2;
-        let h = k.h;
-        let radius = k.radius();
-        let sh = &self.scratch.shepard;
-        let gv = &self.scratch.gradv;
-        let cache = &self.scratch;
-        // σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
-        let sig: Vec<Matrix> = (0..p.len())
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
-            .map(|i| {
-                let c = bc[p.body[i] as usize];
-                if !c.deformable {
-                    return Matrix::zeros();
-                }
-                let pr = p.pressure(i, c.bulk);
-                (p.sdev[i] - Matrix::identity() * pr) / (p.rho[i] * p.rho[i] * sh[i])
-            })
-            .collect();
-        let out: Vec<(Vector, f64)> = (0..p.len())
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
-            .map(|i| {
-                let bi = p.body[i];
-                let c = bc[bi as usize];
-                // Kinematic particles follow their prescribed motion: their force is never used.
-                if !c.deformable || p.flags[i] & KINEMATIC != 0 {
-                    return (Vector::zeros(), 0.0);
-                }
-                if cache.pairs.count[i] < MIN_SUPPORT_NEIGHBOURS {
-                    return (g, 0.0);
-                }
-                let vi = p.vel[i];
-                let voli = p.mass[i] / p.rho[i];
-                let mut a = Vector::zeros();
-                let mut fhg = Vector::zeros();
-                for &Pair { j, xij, r, w, dw } in cache.pairs.of(nl, i) {
-                    if r == 0.0 {
-                        continue;
-                    }
-                    let grad = xij * (dw / r);
-                    a += (sig[i] + sig[j]) * grad * p.mass[j];
-                    if alpha > 0.0 && w > 0.0 {
-                        let e = xij / r;
-                        // Not cache.vol: the stress stage has moved ρ since (continuity), and
-                        // both volumes must be the same step's for a symmetric pair force.
-                        let volj = p.mass[j] / p.rho[j];
-                        // Heavily sheared material can bring two particles almost on top of
-                        // each other; 1/r² then makes the pair force stiff enough to blow the
-                        // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
-                        // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
-                        let rr = r.max(HG_MIN_SEPARATION_H * h);
-                        let cij = alpha * voli * volj * w / (rr * rr);
-                        // Viscous part: velocity error against the mean velocity gradient.
-                        let vij = vi - p.vel[j];
-                        let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
-                        let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
-                        // Stiffness part: separation error against the mean deformation gradient.
-                        let xr = p.x_ref[i] - p.x_ref[j];
-                        let stiff = if xr.norm() < radius {
-                            let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
-                            c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
-                        } else {
-                            0.0
-                        };
-                        fhg -= e * (cij * 0.5 * (stiff + visc));
-                    }
-                }
-                let acc = a + fhg / p.mass[i] + g;
-                (acc, fhg.dot(&vi) * dt)
-            })
-            .collect();
-        let s = &mut self.scratch;
-        s.acc.clear();
-        let mut hg = 0.0;
-        for (a, wk) in out {
-            s.acc.push(a);
-            hg += wk;
-        }
+        let s = SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        };
+        let sc = &mut self.scratch;
+        let hg = stages::forces(
+            s,
+            &sc.pairs,
+            &sc.sums.shepard,
+            &sc.gradv,
+            &self.settings,
+            dt,
+            &mut sc.acc,
+        );
         self.work.hourglass += hg;
     }
 
@@ -666,8 +411,7 @@ impl World {
                 .spring
                 .par_iter_mut()
                 .zip(c.penetration.par_iter_mut())
-                .with_min_len(MIN_LEN)
-                .with_max_len(MAX_LEN)
+                .par_tasks()
                 .enumerate()
                 .map(|(i, (dl, pen_prev))| {
                     if p.body[i] != sec {
@@ -781,8 +525,7 @@ impl World {
             .zip(p.vel.par_iter_mut())
             .zip(p.body.par_iter())
             .zip(p.local.par_iter())
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
+            .par_tasks()
             .for_each(|(((x, v), &b), l)| {
                 if !moving[b as usize] {
                     return;
@@ -824,8 +567,7 @@ impl World {
             .pos
             .par_iter_mut()
             .zip(p.vel.par_iter_mut())
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
+            .par_tasks()
             .enumerate()
             .map(|(i, (x, v))| {
                 let b = p.body[i] as usize;
@@ -938,7 +680,7 @@ impl World {
     /// Runs the configured density filter now (eq. 12, or its MLS form) and books the change
     /// of elastic energy as the filter's work; `step` calls it every `shepard_interval` steps.
     pub fn filter_density(&mut self) {
-        let bc = self.body_consts();
+        let bc = stages::body_consts(&self.bodies);
         self.filter_density_with(&bc);
     }
 
@@ -960,8 +702,7 @@ impl World {
         let mls = self.settings.density_filter == DensityFilter::Mls;
         let rho: Vec<f64> = (0..p.len())
             .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .with_max_len(MAX_LEN)
+            .par_tasks()
             .map(|i| {
                 let bi = p.body[i];
                 if !bc[bi as usize].deformable {
@@ -1011,19 +752,4 @@ fn mls_density(p: &Particles, nl: &NeighbourLists, k: &Kernel, i: usize) -> Opti
     let beta = a.try_inverse()?.column(0).into_owned();
     let rho = beta.dot(&b);
     (rho.is_finite() && rho > 0.0).then_some(rho)
-}
-
-/// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a
-/// well-conditioned inverse (an isolated fragment), the uncorrected gradient is used instead.
-fn correction(m: Matrix) -> Matrix {
-    let tr = m.trace();
-    let det = m.determinant();
-    // Smallest eigenvalue of the symmetric part relative to the mean: a conditioning measure.
-    let disc = ((tr * 0.5).powi(2) - det).max(0.0).sqrt();
-    let lmin = tr * 0.5 - disc;
-    if tr > 0.0 && lmin > 0.05 * tr * 0.5 {
-        m.try_inverse().unwrap_or_else(Matrix::identity)
-    } else {
-        Matrix::identity()
-    }
 }
