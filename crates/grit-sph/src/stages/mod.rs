@@ -2,15 +2,25 @@
 //! functions: each borrows what it reads, writes into the outputs it is given and returns the
 //! rest. `World::step` is the one place that runs them, in order.
 
+mod contact;
+mod density_filter;
 mod forces;
+mod integrate;
 mod kernel_sums;
 mod rates;
+mod rigid;
 mod stress;
+mod time_step;
 
+pub(crate) use contact::{contact, PassedThrough};
+pub(crate) use density_filter::filter_density;
 pub(crate) use forces::forces;
+pub(crate) use integrate::{integrate, Blowup};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};
 pub(crate) use rates::velocity_gradients;
+pub(crate) use rigid::rigid;
 pub(crate) use stress::stress;
+pub(crate) use time_step::stable_dt;
 
 use rayon::iter::{IndexedParallelIterator, MaxLen, MinLen};
 
