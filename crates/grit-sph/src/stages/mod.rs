@@ -50,8 +50,9 @@ const MIN_LEN: usize = 64;
 const MAX_LEN: usize = 256;
 
 /// The task sizes of every parallel loop over particles. Each task writes only its own
-/// particles and every sum across particles is gathered serially, so the task sizes change the
-/// speed, never the results.
+/// particles, every sum across particles is gathered serially, and the one parallel reduction
+/// (the time step's maximum speed) does not depend on order, so the task sizes change the speed,
+/// never the results.
 pub(crate) trait ParTasks: IndexedParallelIterator {
     /// This loop, split into tasks of `MIN_LEN` to `MAX_LEN` particles.
     fn par_tasks(self) -> MaxLen<MinLen<Self>> {

@@ -337,6 +337,9 @@ impl World {
         self.work.density_filter += self.energy().elastic - before;
     }
 
+    // The stage calls of `step` and `run_stage`: each hands one stage of `crate::stages` the
+    // arrays it reads and writes, and books what it returns.
+
     /// What the SPH sums of the stages read.
     fn sph<'a>(&'a self, bc: &'a [BodyConst]) -> SphView<'a> {
         SphView {
