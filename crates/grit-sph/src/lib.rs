@@ -17,6 +17,7 @@ pub mod math;
 pub mod neighbours;
 pub mod particles;
 pub mod physics;
+mod stages;
 pub mod timers;
 pub mod vtk;
 pub mod world;

@@ -1,9 +1,15 @@
 //! Cell-list neighbour search with a Verlet skin: lists hold every pair within
-//! support radius + skin and are reused until some particle has moved half the skin.
+//! support radius + skin and are reused until some particle has moved half the skin. Also which
+//! bodies' particles list each other, the optional cell ordering of the particles, and the
+//! same-body pair cache every SPH sum of a step reads.
 
 use rayon::prelude::*;
 
+use crate::body::Body;
+use crate::contact::ContactPair;
+use crate::kernel::Kernel;
 use crate::math::Vector;
+use crate::particles::{Particles, BOUNDARY};
 
 /// Neighbour lists in compressed rows: the neighbours of `i` are `list[start[i]..start[i+1]]`,
 /// in increasing index order, so every sum over them runs in one fixed order.
@@ -113,6 +119,158 @@ pub fn build_naive(
         start.push(list.len() as u32);
     }
     NeighbourLists { start, list }
+}
+
+/// Builds the lists of a world's particles with reach `radius`: deformable particles see their own
+/// body and the primary boundary particles they can touch; rigid secondary boundary particles
+/// see their primaries.
+pub(crate) fn build_for_bodies(
+    p: &Particles,
+    bodies: &[Body],
+    contacts: &[ContactPair],
+    radius: f64,
+) -> NeighbourLists {
+    let nb = bodies.len();
+    // relation[a * nb + b]: can a particle of body a list one of body b?
+    let mut relation = vec![false; nb * nb];
+    let mut is_secondary = vec![false; nb];
+    let mut is_primary = vec![false; nb];
+    for (a, body) in bodies.iter().enumerate() {
+        if !body.is_rigid() {
+            relation[a * nb + a] = true;
+        }
+    }
+    for c in contacts {
+        relation[c.secondary * nb + c.primary] = true;
+        is_secondary[c.secondary] = true;
+        is_primary[c.primary] = true;
+    }
+    let n = p.len();
+    let rigid: Vec<bool> = bodies.iter().map(|b| b.is_rigid()).collect();
+    let searcher: Vec<bool> = (0..n)
+        .map(|i| {
+            let b = p.body[i] as usize;
+            !rigid[b] || (is_secondary[b] && p.flags[i] & BOUNDARY != 0)
+        })
+        .collect();
+    let candidate: Vec<bool> = (0..n)
+        .map(|i| {
+            let b = p.body[i] as usize;
+            !rigid[b] || (is_primary[b] && p.flags[i] & BOUNDARY != 0)
+        })
+        .collect();
+    let body = &p.body;
+    build(&p.pos, &searcher, &candidate, radius, |i, j| {
+        relation[body[i] as usize * nb + body[j] as usize]
+    })
+}
+
+/// Whether some particle has moved farther than `half_skin` from its position `x_build` at the
+/// last build, so the lists may miss a pair.
+pub(crate) fn stale(pos: &[Vector], x_build: &[Vector], half_skin: f64) -> bool {
+    let lim = half_skin * half_skin;
+    pos.par_iter()
+        .zip(x_build)
+        .any(|(x, x0)| (x - x0).norm_squared() > lim)
+}
+
+/// The particle order by body, then deformable particles by the Z-order (Morton) index of their
+/// neighbour-search cell of size `cell`, ties by current index; rigid bodies keep their order.
+/// `None` when the particles are in that order already.
+pub(crate) fn cell_order(p: &Particles, bodies: &[Body], cell: f64) -> Option<Vec<usize>> {
+    let n = p.len();
+    if n == 0 {
+        return None;
+    }
+    let lo = p.pos.iter().fold(p.pos[0], |a, x| a.inf(x));
+    let deformable: Vec<bool> = bodies.iter().map(|b| !b.is_rigid()).collect();
+    let key = |i: usize| -> u64 {
+        if !deformable[p.body[i] as usize] {
+            return 0;
+        }
+        let c = (p.pos[i] - lo) / cell;
+        // Cells past 2^31 along an axis (a particle flung far off) share the last one.
+        let ix = c.x.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
+        let iy = c.y.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
+        morton(ix, iy)
+    };
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&i| (p.body[i], key(i), i));
+    if order.iter().enumerate().all(|(k, &i)| k == i) {
+        return None;
+    }
+    Some(order)
+}
+
+/// Interleaves the bits of `x` and `y` (x in the even bits): the Z-order curve index of a cell.
+fn morton(x: u32, y: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
+        v
+    }
+    spread(x) | (spread(y) << 1)
+}
+
+/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Pair {
+    pub j: usize,
+    pub xij: Vector,
+    pub r: f64,
+    pub w: f64,
+    pub dw: f64,
+}
+
+/// The same-body neighbours of `i` with their kernel values: the loop every SPH sum of the
+/// deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
+pub(crate) fn body_pairs<'a>(
+    p: &'a Particles,
+    nl: &'a NeighbourLists,
+    k: &'a Kernel,
+    i: usize,
+) -> impl Iterator<Item = Pair> + 'a {
+    let (bi, xi) = (p.body[i], p.pos[i]);
+    let r2max = k.radius() * k.radius();
+    nl.of(i)
+        .iter()
+        .map(|&j| j as usize)
+        .filter(move |&j| p.body[j] == bi)
+        .filter_map(move |j| {
+            let xij = xi - p.pos[j];
+            let r2 = xij.norm_squared();
+            // The lists reach a skin beyond the support; those pairs would add exact zeros.
+            if r2 >= r2max {
+                return None;
+            }
+            let r = r2.sqrt();
+            let (w, dw) = k.w_dw(r);
+            Some(Pair { j, xij, r, w, dw })
+        })
+}
+
+/// Same-body pairs of this step with their kernel values, in each particle's slice of the
+/// neighbour rows (first `count[i]` entries used): computed once in the kernel sums, read by the
+/// rates and the forces, so each pair's kernel is evaluated once per step.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PairCache {
+    /// Pairs, laid out like the neighbour rows.
+    pub pairs: Vec<Pair>,
+    /// Pairs used in each particle's row.
+    pub count: Vec<u32>,
+}
+
+impl PairCache {
+    /// The cached same-body pairs of particle `i` (filled by the kernel sums this step).
+    #[inline]
+    pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [Pair] {
+        let s = nl.start[i] as usize;
+        &self.pairs[s..s + self.count[i] as usize]
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,163 @@
+//! The contact stage: detection and forces for every contact pair (seed section 3,
+//! eqs. 21–29), with the reactions on the rigid bodies gathered in particle order.
+
+use rayon::prelude::*;
+
+use super::{ParTasks, SphView};
+use crate::body::{Body, Motion};
+use crate::contact::{self, ContactPair};
+use crate::math::{cross, Vector};
+
+/// One secondary particle's contact in this step.
+struct Hit {
+    /// Force on the secondary particle (N/m); its nearest primary particle takes the opposite.
+    force: Vector,
+    /// Nearest primary boundary particle.
+    nearest: usize,
+    /// Distance from the primary surface (eq. 21) (m).
+    distance: f64,
+    /// Work of the contact dashpot over the step (J/m).
+    damping_work: f64,
+}
+
+/// A secondary particle found on the far side of a primary surface: the step has failed.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PassedThrough {
+    /// Index of the contact pair.
+    pub pair: usize,
+    /// Index of the secondary particle.
+    pub particle: usize,
+    /// Its distance from the primary surface (m), negative.
+    pub distance: f64,
+}
+
+/// Contact detection and forces for every pair (eqs. 21–29) with equilibrium distance `dx`:
+/// the force on each particle into `force`, the reactions into the rigid bodies' contact force
+/// and torque, the dashpot work added to `damping_work`. Reactions are collected per rigid body
+/// in particle order, so the sums do not depend on the thread count. Stops at the first pair
+/// in which a particle has passed through the primary surface, and returns it.
+pub(crate) fn contact(
+    s: SphView<'_>,
+    dx: f64,
+    dt: f64,
+    contacts: &mut [ContactPair],
+    bodies: &mut [Body],
+    force: &mut Vec<Vector>,
+    damping_work: &mut f64,
+) -> Option<PassedThrough> {
+    let SphView { p, nl, k, .. } = s;
+    let n = p.len();
+    force.clear();
+    force.resize(n, Vector::zeros());
+    for b in bodies.iter_mut() {
+        if let Some(r) = b.rigid_mut() {
+            r.contact_force_n_m = Vector::zeros();
+            r.contact_torque_n = 0.0;
+        }
+    }
+    for (ci, c) in contacts.iter_mut().enumerate() {
+        let (prim, sec) = (c.primary as u32, c.secondary as u32);
+        let (k_r, k_f, mu, zeta, model) = (
+            c.k_r,
+            c.k_f,
+            c.params.friction,
+            c.params.damping_ratio,
+            c.params.model,
+        );
+        let prim_fixed = matches!(
+            bodies[c.primary].rigid().map(|r| r.motion),
+            Some(Motion::Fixed)
+        );
+        let sec_fixed = matches!(
+            bodies[c.secondary].rigid().map(|r| r.motion),
+            Some(Motion::Fixed)
+        );
+        let hits: Vec<Option<Hit>> = c
+            .spring
+            .par_iter_mut()
+            .zip(c.penetration.par_iter_mut())
+            .par_tasks()
+            .enumerate()
+            .map(|(i, (dl, pen_prev))| {
+                if p.body[i] != sec {
+                    return None;
+                }
+                let js = nl
+                    .of(i)
+                    .iter()
+                    .map(|&j| j as usize)
+                    .filter(|&j| p.body[j] == prim);
+                let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| {
+                    p.mass[j] / p.rho[j]
+                });
+                let det = match det {
+                    Some(d) if d.penetration > 0.0 => d,
+                    _ => {
+                        *dl = Vector::zeros();
+                        *pen_prev = 0.0;
+                        return None;
+                    }
+                };
+                let pen_rate = (det.penetration - *pen_prev) / dt;
+                *pen_prev = det.penetration;
+                let j = det.nearest;
+                let vrel = p.vel[i] - p.vel[j];
+                let fr = det.repulsion;
+                let m_eff = match (sec_fixed, prim_fixed) {
+                    (true, _) => p.mass[j],
+                    (_, true) => p.mass[i],
+                    _ => p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]),
+                };
+                let c_t = 2.0 * zeta * (k_f * m_eff).sqrt();
+                let ff = contact::friction(dl, vrel, det.normal, dt, k_f, c_t, mu, fr.norm());
+                let cdamp = 2.0 * zeta * (k_r * m_eff).sqrt();
+                let fd = det.normal * (cdamp * pen_rate);
+                let work = -fd.norm() * pen_rate.abs() * dt;
+                Some(Hit {
+                    force: fr + ff + fd,
+                    nearest: j,
+                    distance: det.distance,
+                    damping_work: work,
+                })
+            })
+            .collect();
+        // Sequential gather: eq. 29 reactions and eq. 17 sums in particle order.
+        let mut damp = 0.0;
+        let mut through = None;
+        for (i, h) in hits.into_iter().enumerate() {
+            let Some(Hit {
+                force: f,
+                nearest: j,
+                distance: dist,
+                damping_work: work,
+            }) = h
+            else {
+                continue;
+            };
+            force[i] += f;
+            force[j] -= f;
+            damp += work;
+            if dist < 0.0 && through.is_none() {
+                through = Some((i, dist));
+            }
+            let bj = &mut bodies[c.primary];
+            if let Some(r) = bj.rigid_mut() {
+                r.contact_force_n_m -= f;
+                r.contact_torque_n += cross(p.pos[j] - r.com_m, -f);
+            }
+            if let Some(r) = bodies[c.secondary].rigid_mut() {
+                r.contact_force_n_m += f;
+                r.contact_torque_n += cross(p.pos[i] - r.com_m, f);
+            }
+        }
+        *damping_work += damp;
+        if let Some((i, dist)) = through {
+            return Some(PassedThrough {
+                pair: ci,
+                particle: i,
+                distance: dist,
+            });
+        }
+    }
+    None
+}

@@ -1,0 +1,117 @@
+//! The kernel sums: Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator) and Bonet–Lok correction
+//! matrices L_i (eq. 8), and the same-body pair cache the rates and forces read.
+
+use rayon::prelude::*;
+
+use super::{ParTasks, SphView};
+use crate::math::{outer, Matrix};
+use crate::neighbours::{body_pairs, Pair, PairCache};
+
+/// Per-particle results of the kernel sums, read by the later stages of the same step.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct KernelSums {
+    /// Particle volumes m/ρ at the kernel sums, computed once instead of once per pair; valid
+    /// until the stress stage updates ρ.
+    pub vol: Vec<f64>,
+    /// Shepard sums Γ_i (eq. 9 denominator).
+    pub shepard: Vec<f64>,
+    /// Bonet–Lok correction matrices L_i (eq. 8).
+    pub lcorr: Vec<Matrix>,
+}
+
+/// One particle's kernel sums, before they are stored.
+struct ParticleSums {
+    shepard: f64,
+    lcorr: Matrix,
+    pairs: u32,
+}
+
+/// Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator) and Bonet–Lok matrices L_i (eq. 8) into
+/// `sums`; every same-body pair inside the support into `cache`.
+pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut KernelSums) {
+    let SphView { p, nl, k, bc } = s;
+    let w0 = k.w(0.0);
+    let n = p.len();
+    sums.vol.clear();
+    sums.vol.par_extend(
+        p.mass
+            .par_iter()
+            .zip(&p.rho)
+            .par_tasks()
+            .map(|(m, r)| m / r),
+    );
+    let vol = &sums.vol;
+    let buf = &mut cache.pairs;
+    // Rows are overwritten before they are read: grow, never clear (a memset per step).
+    if buf.len() < nl.list.len() {
+        buf.resize(nl.list.len(), Pair::default());
+    }
+    // One mutable slice per particle, so the rows fill in parallel, each by its own owner.
+    let mut rows: Vec<&mut [Pair]> = Vec::with_capacity(n);
+    let mut rest = buf.as_mut_slice();
+    for i in 0..n {
+        let (row, tail) = rest.split_at_mut(nl.of(i).len());
+        rows.push(row);
+        rest = tail;
+    }
+    let out: Vec<ParticleSums> = rows
+        .into_par_iter()
+        .par_tasks()
+        .enumerate()
+        .map(|(i, row)| {
+            let bi = p.body[i];
+            if !bc[bi as usize].deformable {
+                return ParticleSums {
+                    shepard: 1.0,
+                    lcorr: Matrix::identity(),
+                    pairs: 0,
+                };
+            }
+            let mut g = p.mass[i] / p.rho[i] * w0;
+            let mut m = Matrix::zeros();
+            let mut cnt = 0;
+            for pair in body_pairs(p, nl, k, i) {
+                // Listed within the skin but outside the support: contributes nothing.
+                if pair.w == 0.0 && pair.dw == 0.0 {
+                    continue;
+                }
+                let vj = vol[pair.j];
+                g += vj * pair.w;
+                if pair.r > 0.0 {
+                    let grad = pair.xij * (pair.dw / pair.r);
+                    m += outer(-pair.xij, grad) * vj;
+                }
+                row[cnt] = pair;
+                cnt += 1;
+            }
+            ParticleSums {
+                shepard: g,
+                lcorr: correction(m),
+                pairs: cnt as u32,
+            }
+        })
+        .collect();
+    sums.shepard.clear();
+    sums.lcorr.clear();
+    cache.count.clear();
+    for o in out {
+        sums.shepard.push(o.shepard);
+        sums.lcorr.push(o.lcorr);
+        cache.count.push(o.pairs);
+    }
+}
+
+/// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a
+/// well-conditioned inverse (an isolated fragment), the uncorrected gradient is used instead.
+fn correction(m: Matrix) -> Matrix {
+    let tr = m.trace();
+    let det = m.determinant();
+    // Smallest eigenvalue of the symmetric part relative to the mean: a conditioning measure.
+    let disc = ((tr * 0.5).powi(2) - det).max(0.0).sqrt();
+    let lmin = tr * 0.5 - disc;
+    if tr > 0.0 && lmin > 0.05 * tr * 0.5 {
+        m.try_inverse().unwrap_or_else(Matrix::identity)
+    } else {
+        Matrix::identity()
+    }
+}

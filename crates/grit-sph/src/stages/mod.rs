@@ -1,0 +1,100 @@
+//! The stages of one explicit step (docs/design.md "Engine step"; seed sections 2 and 3), as free
+//! functions: each borrows what it reads, writes into the outputs it is given and returns the
+//! rest. `World::step` is the one place that runs them, in order.
+
+mod contact;
+mod density_filter;
+mod forces;
+mod integrate;
+mod kernel_sums;
+mod rates;
+mod rigid;
+mod stress;
+mod time_step;
+
+pub(crate) use contact::{contact, PassedThrough};
+pub(crate) use density_filter::filter_density;
+pub(crate) use forces::forces;
+pub(crate) use integrate::{integrate, Blowup};
+pub(crate) use kernel_sums::{kernel_sums, KernelSums};
+pub(crate) use rates::velocity_gradients;
+pub(crate) use rigid::rigid;
+pub(crate) use stress::stress;
+pub(crate) use time_step::stable_dt;
+
+use rayon::iter::{IndexedParallelIterator, MaxLen, MinLen};
+
+use crate::body::Body;
+use crate::kernel::Kernel;
+use crate::neighbours::NeighbourLists;
+use crate::particles::Particles;
+
+/// A deformable particle with fewer same-body neighbours inside the kernel support than this is
+/// a fragment torn off its body: its kernel sums no longer describe a continuum (the Shepard
+/// normalisation of eq. 9 divides by a near-empty sum and blows up), so it flies ballistically,
+/// keeping its stress, until it rejoins material. A particle inside a body has about 44.
+pub const MIN_SUPPORT_NEIGHBOURS: u32 = 6;
+
+/// Pair separation (in h) below which the hourglass force of eq. 16 stops growing as 1/r².
+pub const HG_MIN_SEPARATION_H: f64 = 0.4;
+
+/// Smallest number of particles one rayon task takes: below it the per-task overhead costs more
+/// than the work.
+const MIN_LEN: usize = 64;
+
+/// Largest number of particles one rayon task takes. The work of a step is uneven along the
+/// index (the grain's particles and the free surface do less, the few hundred particles under
+/// the grain do the contact), and rayon's adaptive splitting can leave a few large tasks, so one
+/// thread sits idle while the other finishes; small tasks let the idle thread steal
+/// (docs/performance.md, "Smaller tasks").
+const MAX_LEN: usize = 256;
+
+/// The task sizes of every parallel loop over particles. Each task writes only its own
+/// particles, every sum across particles is gathered serially, and the one parallel reduction
+/// (the time step's maximum speed) does not depend on order, so the task sizes change the speed,
+/// never the results.
+pub(crate) trait ParTasks: IndexedParallelIterator {
+    /// This loop, split into tasks of `MIN_LEN` to `MAX_LEN` particles.
+    fn par_tasks(self) -> MaxLen<MinLen<Self>> {
+        self.with_min_len(MIN_LEN).with_max_len(MAX_LEN)
+    }
+}
+
+impl<I: IndexedParallelIterator> ParTasks for I {}
+
+/// Per-body constants the stages need, looked up by particle.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct BodyConst {
+    pub deformable: bool,
+    pub bulk: f64,
+    pub shear: f64,
+    pub youngs: f64,
+    pub sound: f64,
+}
+
+/// The constants of each body, by body index (all zero and not deformable for a rigid body).
+pub(crate) fn body_consts(bodies: &[Body]) -> Vec<BodyConst> {
+    bodies
+        .iter()
+        .map(|b| match b.material() {
+            Some(m) => BodyConst {
+                deformable: true,
+                bulk: m.bulk_modulus(),
+                shear: m.shear_modulus(),
+                youngs: m.youngs_modulus_pa,
+                sound: m.sound_speed(),
+            },
+            None => BodyConst::default(),
+        })
+        .collect()
+}
+
+/// What the SPH sums over neighbours read: the particles, their neighbour lists, the kernel and
+/// the per-body constants.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SphView<'a> {
+    pub p: &'a Particles,
+    pub nl: &'a NeighbourLists,
+    pub k: &'a Kernel,
+    pub bc: &'a [BodyConst],
+}

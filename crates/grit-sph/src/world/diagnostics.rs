@@ -1,0 +1,101 @@
+//! What a world reports about itself: its energy, momentum and the work of numerical devices.
+
+use serde::{Deserialize, Serialize};
+
+use super::World;
+use crate::body::Motion;
+use crate::math::Vector;
+use crate::particles::dev_contract;
+
+/// Energy of the world and what the numerics have added or taken (J/m, per unit depth).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Energy {
+    /// Kinetic energy of deformable particles and rigid bodies.
+    pub kinetic: f64,
+    /// Elastic strain energy: V (p²/2K + s:s/4G) summed over deformable particles.
+    pub elastic: f64,
+    /// Energy stored in the contact repulsion springs.
+    pub contact: f64,
+    /// Potential energy in gravity.
+    pub gravity: f64,
+}
+
+impl Energy {
+    /// Kinetic plus elastic plus contact plus gravity.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.contact + self.gravity
+    }
+}
+
+/// Running totals of work done by numerical devices (J/m); negative means dissipated.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct NumericalWork {
+    /// Work of the hourglass forces (eq. 16).
+    pub hourglass: f64,
+    /// Change of elastic energy at the Shepard density filter (eq. 12).
+    pub density_filter: f64,
+    /// Work of the contact dashpots.
+    pub contact_damping: f64,
+    /// Plastic work (heat and stored work of plasticity).
+    pub plastic: f64,
+    /// Work of the absorbing layers (`Absorber`).
+    #[serde(default)]
+    pub absorbed: f64,
+}
+
+impl World {
+    /// Kinetic, elastic, contact-spring and gravity energy (J/m).
+    pub fn energy(&self) -> Energy {
+        let bc = crate::stages::body_consts(&self.bodies);
+        let p = &self.particles;
+        let mut e = Energy::default();
+        for i in 0..p.len() {
+            let b = p.body[i] as usize;
+            if !bc[b].deformable {
+                continue;
+            }
+            e.kinetic += 0.5 * p.mass[i] * p.vel[i].norm_squared();
+            let vol = p.mass[i] / p.rho[i];
+            let pr = p.pressure(i, bc[b].bulk);
+            e.elastic += vol
+                * (pr * pr / (2.0 * bc[b].bulk) + dev_contract(&p.sdev[i]) / (4.0 * bc[b].shear));
+            e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
+        }
+        for b in &self.bodies {
+            if let Some(r) = b.rigid() {
+                if r.motion == Motion::Free {
+                    e.kinetic += 0.5 * r.mass_kg_m * r.velocity_m_s.norm_squared()
+                        + 0.5 * r.inertia_kg_m * r.omega_rad_s * r.omega_rad_s;
+                    e.gravity -= r.mass_kg_m * self.settings.gravity_m_s2.dot(&r.com_m);
+                }
+            }
+        }
+        for c in &self.contacts {
+            for (i, &pen) in c.penetration.iter().enumerate() {
+                if pen > 0.0 {
+                    e.contact += 0.5 * c.k_r * pen * pen + 0.5 * c.spring[i].norm_squared() * c.k_f;
+                }
+            }
+        }
+        e
+    }
+
+    /// Total linear momentum of deformable particles and free rigid bodies (kg·m/s per m).
+    pub fn momentum(&self) -> Vector {
+        let p = &self.particles;
+        let mut m = Vector::zeros();
+        for i in 0..p.len() {
+            if self.bodies[p.body[i] as usize].material().is_some() {
+                m += p.vel[i] * p.mass[i];
+            }
+        }
+        for b in &self.bodies {
+            if let Some(r) = b.rigid() {
+                if r.motion == Motion::Free {
+                    m += r.velocity_m_s * r.mass_kg_m;
+                }
+            }
+        }
+        m
+    }
+}

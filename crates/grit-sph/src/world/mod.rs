@@ -1,0 +1,474 @@
+//! The world: bodies, particles and contacts, and the explicit step that advances them
+//! (docs/design.md "Engine step"; seed section 2 for the solid, section 3 for contact).
+//!
+//! `step` lists the stages in order; each stage is a free function in `crate::stages` that this
+//! module hands the world's arrays. Building a world is in `build`, its settings in `settings`,
+//! what it reports about itself in `diagnostics`.
+
+mod build;
+mod diagnostics;
+mod settings;
+
+pub use crate::stages::{HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
+pub use diagnostics::{Energy, NumericalWork};
+pub use settings::{DensityFilter, Settings, MAX_CFL};
+
+use serde::{Deserialize, Serialize};
+
+use crate::body::Body;
+use crate::contact::{ContactPair, ContactParams};
+use crate::error::{InputError, SimError};
+use crate::kernel::Kernel;
+use crate::math::{Matrix, Vector};
+use crate::neighbours::{self, NeighbourLists, PairCache};
+use crate::particles::Particles;
+use crate::stages::{self, Blowup, BodyConst, KernelSums, PassedThrough, SphView};
+use crate::timers::{Stage, Timers};
+
+/// Scratch arrays rebuilt every step (not part of a checkpoint).
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
+    pairs: PairCache,
+    /// Volumes, Shepard sums and correction matrices of the kernel sums.
+    sums: KernelSums,
+    /// Velocity gradients of the rates.
+    gradv: Vec<Matrix>,
+    /// Accelerations of the forces.
+    acc: Vec<Vector>,
+    /// Contact force on each particle.
+    contact_force: Vec<Vector>,
+}
+
+/// A 2D SPH scene: bodies, their particles, contact pairs, time.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct World {
+    settings: Settings,
+    kernel: Kernel,
+    bodies: Vec<Body>,
+    contacts: Vec<ContactPair>,
+    particles: Particles,
+    time: f64,
+    steps: u64,
+    dt: f64,
+    next_id: u32,
+    work: NumericalWork,
+    /// Positions at the last neighbour build.
+    x_build: Vec<Vector>,
+    #[serde(skip)]
+    nbrs: NeighbourLists,
+    #[serde(skip)]
+    nbrs_valid: bool,
+    #[serde(skip)]
+    scratch: Scratch,
+    #[serde(skip)]
+    timers: Timers,
+}
+
+impl World {
+    /// An empty world with validated settings.
+    pub fn new(settings: Settings) -> Result<Self, InputError> {
+        settings.validate()?;
+        let kernel = Kernel::new(settings.kernel, settings.h_over_dx * settings.spacing_m);
+        Ok(World {
+            settings,
+            kernel,
+            bodies: Vec::new(),
+            contacts: Vec::new(),
+            particles: Particles::default(),
+            time: 0.0,
+            steps: 0,
+            dt: 0.0,
+            next_id: 0,
+            work: NumericalWork::default(),
+            x_build: Vec::new(),
+            nbrs: NeighbourLists::default(),
+            nbrs_valid: false,
+            scratch: Scratch::default(),
+            timers: Timers::default(),
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    /// The kernel in use.
+    pub fn kernel(&self) -> &Kernel {
+        &self.kernel
+    }
+    /// Smoothing length h (m).
+    pub fn h(&self) -> f64 {
+        self.kernel.h
+    }
+    /// All bodies.
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+    /// One body, mutable (to change a rigid body's motion or external force between phases).
+    pub fn body_mut(&mut self, b: usize) -> &mut Body {
+        &mut self.bodies[b]
+    }
+    /// All particles.
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    /// The time step the next step will take (s); 0 before the first step.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// Per-stage timers.
+    pub fn timers(&self) -> &Timers {
+        &self.timers
+    }
+    /// Per-stage timers, mutable (to reset between measurements).
+    pub fn timers_mut(&mut self) -> &mut Timers {
+        &mut self.timers
+    }
+    /// Work of numerical devices so far.
+    pub fn numerical_work(&self) -> NumericalWork {
+        self.work
+    }
+    /// The contact pairs.
+    pub fn contacts(&self) -> &[ContactPair] {
+        &self.contacts
+    }
+    /// Parameters of contact pair `c`, mutable (to end a settling phase's damping, say).
+    pub fn contact_params_mut(&mut self, c: usize) -> &mut ContactParams {
+        &mut self.contacts[c].params
+    }
+    /// Contact force on each particle in the last step (N/m); empty before the first step.
+    pub fn contact_forces(&self) -> &[Vector] {
+        &self.scratch.contact_force
+    }
+    /// Neighbour count of each particle as last built (for reports).
+    pub fn neighbour_pairs(&self) -> usize {
+        self.nbrs.pairs()
+    }
+
+    /// Reach of the neighbour lists, and the cell size of the cell order: the kernel support
+    /// plus the Verlet skin.
+    fn neighbour_reach(&self) -> f64 {
+        self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m
+    }
+
+    /// Rebuilds neighbour lists (`neighbours::build_for_bodies`), first putting the particles in
+    /// cell order where `Settings::cell_order` asks for it.
+    fn rebuild_neighbours(&mut self) {
+        if self.settings.cell_order {
+            let cell = self.neighbour_reach();
+            if let Some(order) = neighbours::cell_order(&self.particles, &self.bodies, cell) {
+                self.reorder_particles(&order);
+            }
+        }
+        let radius = self.neighbour_reach();
+        self.nbrs =
+            neighbours::build_for_bodies(&self.particles, &self.bodies, &self.contacts, radius);
+        self.x_build = self.particles.pos.clone();
+        self.nbrs_valid = true;
+    }
+
+    fn needs_rebuild(&self) -> bool {
+        if !self.nbrs_valid || self.x_build.len() != self.particles.len() {
+            return true;
+        }
+        let half = 0.5 * self.settings.skin_over_dx * self.settings.spacing_m;
+        neighbours::stale(&self.particles.pos, &self.x_build, half)
+    }
+
+    /// Stable time step: CFL on the material signal speed plus particle speed, and the
+    /// contact springs' period.
+    fn compute_dt(&self) -> f64 {
+        let bc = stages::body_consts(&self.bodies);
+        stages::stable_dt(
+            &self.particles,
+            &bc,
+            self.kernel.h,
+            &self.settings,
+            &self.contacts,
+        )
+    }
+
+    /// The time step the next `step` will take: CFL on the current state, and the contact
+    /// springs' period.
+    pub fn next_dt(&self) -> f64 {
+        if self.dt == 0.0 {
+            self.compute_dt()
+        } else {
+            self.dt
+        }
+    }
+
+    /// Counts `steps` steps of `dt_s` as taken without computing them, for a stretch in which
+    /// nothing but a rigid body's free flight would happen (an impact's approach). The
+    /// clock and the phase of the work done every k steps (the density filter, eq. 12) then
+    /// stay those of the full run.
+    pub fn count_skipped_steps(&mut self, steps: u64, dt_s: f64) {
+        self.steps += steps;
+        self.time += steps as f64 * dt_s;
+    }
+
+    /// Advances the world by one explicit step (docs/design.md "Engine step").
+    pub fn step(&mut self) -> Result<(), SimError> {
+        if self.dt == 0.0 {
+            self.dt = self.compute_dt();
+        }
+        let dt = self.dt;
+        let n = self.particles.len();
+        let bc = stages::body_consts(&self.bodies);
+
+        let mut timers = std::mem::take(&mut self.timers);
+        if self.needs_rebuild() {
+            timers.time(Stage::Neighbours, || self.rebuild_neighbours());
+        }
+        timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
+        timers.time(Stage::Rates, || self.rates(&bc));
+        timers.time(Stage::Stress, || self.stress(&bc, dt));
+        timers.time(Stage::Forces, || self.forces(&bc, dt));
+        let contact = timers.time(Stage::Contact, || self.contact(&bc, dt));
+        timers.time(Stage::Rigid, || self.rigid(dt));
+        let checked = timers.time(Stage::Integrate, || self.integrate(&bc, dt));
+        self.timers = timers;
+        contact?;
+        checked?;
+        self.time += dt;
+        self.steps += 1;
+        let mut timers = std::mem::take(&mut self.timers);
+        let r = timers.time(Stage::Housekeeping, || self.housekeeping(&bc));
+        self.timers = timers;
+        debug_assert!(self.particles.len() <= n);
+        r
+    }
+
+    /// Runs one stage of `step` (docs/design.md "Engine step") on the current state without
+    /// advancing time, so a benchmark can time the hot loops one by one. Stages after
+    /// `Contact` move particles and are only timed inside `step`.
+    pub fn run_stage(&mut self, stage: Stage) -> Result<(), InputError> {
+        if self.dt == 0.0 {
+            self.dt = self.compute_dt();
+        }
+        let dt = self.dt;
+        let bc = stages::body_consts(&self.bodies);
+        let ready = self.nbrs_valid && self.scratch.pairs.count.len() == self.particles.len();
+        if stage != Stage::Neighbours && !ready {
+            // Every later stage reads the neighbour lists and the kernel-sum caches.
+            self.rebuild_neighbours();
+            self.kernel_sums(&bc);
+            self.rates(&bc);
+        }
+        match stage {
+            Stage::Neighbours => self.rebuild_neighbours(),
+            Stage::KernelSums => self.kernel_sums(&bc),
+            Stage::Rates => self.rates(&bc),
+            Stage::Stress => self.stress(&bc, dt),
+            Stage::Forces => self.forces(&bc, dt),
+            Stage::Contact => {
+                // A surface particle passing through is a result of the state, not of timing.
+                let _ = self.contact(&bc, dt);
+            }
+            other => {
+                return Err(InputError::new(
+                    "stage",
+                    format!("{other:?} moves particles; time it with step()"),
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// Steps until `t_end` (s) or until `stop` says so; returns the number of steps.
+    pub fn run_until(
+        &mut self,
+        t_end: f64,
+        mut stop: impl FnMut(&World) -> bool,
+    ) -> Result<u64, SimError> {
+        let s0 = self.steps;
+        while self.time < t_end && !stop(self) {
+            self.step()?;
+        }
+        Ok(self.steps - s0)
+    }
+
+    /// Shepard density filter (eq. 12) every `shepard_interval` steps, deletion of particles with
+    /// D ≥ 1, and the next time step.
+    fn housekeeping(&mut self, bc: &[BodyConst]) -> Result<(), SimError> {
+        let every = self.settings.shepard_interval as u64;
+        if every > 0 && self.steps.is_multiple_of(every) {
+            self.filter_density_with(bc);
+        }
+        let failed: Vec<bool> = self.particles.damage.iter().map(|&d| d >= 1.0).collect();
+        if failed.iter().any(|&f| f) {
+            for (i, &f) in failed.iter().enumerate() {
+                if f {
+                    let b = self.particles.body[i] as usize;
+                    self.bodies[b].removed_mass_kg_m += self.particles.mass[i];
+                    self.bodies[b].removed_particles += 1;
+                }
+            }
+            let keep: Vec<bool> = failed.iter().map(|f| !f).collect();
+            self.retain_particles(&keep);
+        }
+        self.dt = self.compute_dt();
+        Ok(())
+    }
+
+    /// Runs the configured density filter now (eq. 12, or its MLS form) and books the change
+    /// of elastic energy as the filter's work; `step` calls it every `shepard_interval` steps.
+    pub fn filter_density(&mut self) {
+        let bc = stages::body_consts(&self.bodies);
+        self.filter_density_with(&bc);
+    }
+
+    fn filter_density_with(&mut self, bc: &[BodyConst]) {
+        let before = self.energy().elastic;
+        if !self.nbrs_valid || self.nbrs.start.len() != self.particles.len() + 1 {
+            self.rebuild_neighbours();
+        }
+        let s = self.sph(bc);
+        self.particles.rho = stages::filter_density(s, self.settings.density_filter);
+        self.work.density_filter += self.energy().elastic - before;
+    }
+
+    // The stage calls of `step` and `run_stage`: each hands one stage of `crate::stages` the
+    // arrays it reads and writes, and books what it returns.
+
+    /// What the SPH sums of the stages read.
+    fn sph<'a>(&'a self, bc: &'a [BodyConst]) -> SphView<'a> {
+        SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        }
+    }
+
+    fn kernel_sums(&mut self, bc: &[BodyConst]) {
+        let s = SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        };
+        stages::kernel_sums(s, &mut self.scratch.pairs, &mut self.scratch.sums);
+    }
+
+    fn rates(&mut self, bc: &[BodyConst]) {
+        let gradv =
+            stages::velocity_gradients(self.sph(bc), &self.scratch.pairs, &self.scratch.sums);
+        self.scratch.gradv = gradv;
+    }
+
+    fn stress(&mut self, bc: &[BodyConst], dt: f64) {
+        let beta = self.settings.taylor_quinney;
+        let plastic_work = stages::stress(
+            &mut self.particles,
+            &self.bodies,
+            bc,
+            &self.scratch.gradv,
+            beta,
+            dt,
+        );
+        self.work.plastic -= plastic_work;
+    }
+
+    fn forces(&mut self, bc: &[BodyConst], dt: f64) {
+        let s = SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        };
+        let sc = &mut self.scratch;
+        let hg = stages::forces(
+            s,
+            &sc.pairs,
+            &sc.sums.shepard,
+            &sc.gradv,
+            &self.settings,
+            dt,
+            &mut sc.acc,
+        );
+        self.work.hourglass += hg;
+    }
+
+    fn contact(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
+        let s = SphView {
+            p: &self.particles,
+            nl: &self.nbrs,
+            k: &self.kernel,
+            bc,
+        };
+        let through = stages::contact(
+            s,
+            self.settings.spacing_m,
+            dt,
+            &mut self.contacts,
+            &mut self.bodies,
+            &mut self.scratch.contact_force,
+            &mut self.work.contact_damping,
+        );
+        let Some(PassedThrough {
+            pair,
+            particle: i,
+            distance,
+        }) = through
+        else {
+            return Ok(());
+        };
+        let c = &self.contacts[pair];
+        Err(SimError {
+            step: self.steps,
+            time_s: self.time,
+            what: format!(
+                "particle {} of body '{}' passed through the surface of body '{}': distance {:.3e} m < 0",
+                self.particles.id[i], self.bodies[c.secondary].name, self.bodies[c.primary].name, distance
+            ),
+        })
+    }
+
+    fn rigid(&mut self, dt: f64) {
+        let g = self.settings.gravity_m_s2;
+        stages::rigid(&mut self.bodies, &mut self.particles, g, self.time, dt);
+    }
+
+    fn integrate(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
+        let blowup = stages::integrate(
+            &mut self.particles,
+            &self.bodies,
+            bc,
+            self.kernel.h,
+            &self.scratch.acc,
+            &self.scratch.contact_force,
+            self.time,
+            dt,
+            &mut self.work.absorbed,
+        );
+        let what = match blowup {
+            None => return Ok(()),
+            Some(Blowup::Particle { index: i, what }) => {
+                let p = &self.particles;
+                format!(
+                    "particle {} of body '{}' at ({:.4e}, {:.4e}) m: {what}",
+                    p.id[i], self.bodies[p.body[i] as usize].name, p.pos[i].x, p.pos[i].y
+                )
+            }
+            Some(Blowup::Rigid { body }) => format!(
+                "rigid body '{}': position or velocity is not finite",
+                self.bodies[body].name
+            ),
+        };
+        Err(SimError {
+            step: self.steps,
+            time_s: self.time,
+            what,
+        })
+    }
+}
