@@ -200,10 +200,10 @@ fn studies_refuse_bad_input_naming_the_option() {
     }
 }
 
-/// The figures and JSON names issue 5 fixes, from a coarse impact timed twice each way; the
+/// The figures and JSON names the impact bench promises, from a coarse impact timed twice each way; the
 /// grain shell and flight skip are on by default and can be turned off.
 #[test]
-fn impact_bench_prints_the_issue_fields_with_medians_of_repeats() {
+fn impact_bench_prints_its_fields_with_medians_of_repeats() {
     let run = |extra: &[&str]| -> serde_json::Value {
         let args = [
             &["bench", "impact", "--spacing-m", COARSE, "--json"][..],

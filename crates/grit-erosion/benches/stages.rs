@@ -1,4 +1,4 @@
-//! Criterion bench of the engine's hot loops (issue 5) on the reference impact scene (seed
+//! Criterion bench of the engine's hot loops on the reference impact scene (seed
 //! section 4: hexagon, 45°, 100 m/s, AISI 304) caught mid-contact: neighbour search, kernel
 //! sums (eqs. 8–9), velocity gradient (eq. 15), stress update (eqs. 11, 13, 18–20), forces
 //! (eqs. 6, 16) and contact (eqs. 21–29). `cargo bench -p grit-erosion --bench stages`.

@@ -1,4 +1,4 @@
-//! Speed-up of each engine stage from 1 to 2 threads (issue 5), each stage timed alone on the
+//! Speed-up of each engine stage from 1 to 2 threads, each stage timed alone on the
 //! reference scene caught mid-contact, the two thread counts alternated:
 //! `cargo run --release -p grit-erosion --example stage_scaling -- [SPACING_M [REPEATS]]`.
 use std::time::Instant;

@@ -8,7 +8,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// Vickers hardness of AISI 304 in GPa, the seed paper's surface (reference/NOTES.md:
+/// Vickers hardness of AISI 304 in GPa, the seed paper's surface (docs/references.md#aisi-304:
 /// 1.77–1.8 GPa, the value EDEM and ANSYS Fluent documentation use).
 pub const AISI304_HV_GPA: f64 = 1.8;
 
@@ -54,7 +54,7 @@ fn invalid(field: String, rule: impl Into<String>) -> FitError {
 }
 
 /// Oka's exponents for silica (SiO2) grains: n1 = 0.71 Hv^0.14, n2 = 2.4 Hv^−0.94
-/// (Oka et al. 2005; reference/NOTES.md). Hv = 1.8 gives n1 ≈ 0.771, n2 ≈ 1.381.
+/// (Oka et al. 2005; docs/references.md#erosion-models). Hv = 1.8 gives n1 ≈ 0.771, n2 ≈ 1.381.
 pub fn oka_silica_exponents(hv_gpa: f64) -> (f64, f64) {
     (0.71 * hv_gpa.powf(0.14), 2.4 * hv_gpa.powf(-0.94))
 }

@@ -1,4 +1,4 @@
-//! End to end on a coarse real sample (issue 3): no mass loss during an incubation period,
+//! End to end on a coarse real sample: no mass loss during an incubation period,
 //! then mass loss that grows, and a positive, finite erosion from the last 20 points.
 //! 16 particles per Dg and a 0.5 Dg aim range, so that erosion starts within 70 impacts.
 

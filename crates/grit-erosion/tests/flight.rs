@@ -1,4 +1,4 @@
-//! Issue 5's flight skip: the grain is moved along its force-free path to just before its first
+//! The flight skip (docs/design.md#model-no-more-than-a-scene-needs): the grain is moved along its force-free path to just before its first
 //! contact instead of flying there step by step. On a fresh surface, which is at rest, the
 //! flight does nothing but move the density filter's passes (every 40 steps) against the
 //! contact, so the impact must come out the same within a few per cent at a fraction of the

@@ -1,6 +1,6 @@
 //! A sample is fully determined by its parameters and seed, and resumes from a checkpoint bit
-//! for bit (issue 3: "the same seed gives the same sample", "resume from checkpoint equals the
-//! uninterrupted run"). Coarse scenes: these run real impacts.
+//! for bit: the same seed gives the same sample, and resuming from a checkpoint equals the
+//! uninterrupted run. Coarse scenes: these run real impacts.
 
 use grit_erosion::{ImpactParams, ImpactRecord, Sample, SampleError, Shape};
 use grit_sph::Particles;
@@ -206,7 +206,7 @@ fn one_impact_is_bitwise_the_same_on_1_and_2_threads() {
     assert_eq!(one, two);
 }
 
-/// Issue 5's grain-shell saving: dropping the grain's interior particles must change nothing,
+/// The grain-shell saving: dropping the grain's interior particles must change nothing,
 /// at 45° and at 90°, over several impacts on the same seed.
 #[test]
 fn grain_shell_gives_the_full_grain_bit_for_bit() {

@@ -1,5 +1,5 @@
 //! JSON bodies of the REST API under `/api/v1`, shared by the coordinator and its clients.
-//! Names marked "scripts rely on" in issue 4 are kept exactly.
+//! Names marked "scripts rely on" are a stable interface: they are never renamed.
 
 use std::collections::BTreeMap;
 

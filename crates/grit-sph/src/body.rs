@@ -24,7 +24,7 @@ pub enum Motion {
 
 /// A viscous layer along a deformable body's fixed edges that stands in for the rest of the
 /// body: waves running out of the body are damped in it instead of reflected back (a sponge
-/// layer; issue 5, "model no more"). The damping rate grows as σ_max (d/L)² with the distance
+/// layer; docs/design.md#model-no-more-than-a-scene-needs). The damping rate grows as σ_max (d/L)² with the distance
 /// d of a particle outside the undamped inner box, up to d = L.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Absorber {

@@ -21,8 +21,8 @@ impl InputError {
         }
     }
 
-    /// Checks the rule most physical inputs share: a finite number > 0 (DESIGN.md: errors name
-    /// the field and the rule).
+    /// Checks the rule most physical inputs share: a finite number > 0 (errors name the field and
+    /// the rule: docs/design.md#rules-the-engine-keeps).
     pub fn require_positive(field: impl Into<String>, v: f64) -> Result<(), InputError> {
         if v.is_finite() && v > 0.0 {
             Ok(())
@@ -35,7 +35,7 @@ impl InputError {
     }
 }
 
-/// A simulation that went unstable (DESIGN.md "never fails silently").
+/// A simulation that went unstable (it never fails silently: docs/design.md#rules-the-engine-keeps).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("simulation failed at step {step} (t = {time_s:.6e} s): {what}")]
 pub struct SimError {

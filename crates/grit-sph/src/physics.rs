@@ -13,7 +13,7 @@ pub fn homologous_temperature(jc: &JohnsonCook, t: f64) -> f64 {
 
 /// Johnson–Cook yield stress (eq. 18) and its derivatives with respect to plastic strain and
 /// plastic strain rate. The rate term is (1 + C ln(ε̇/ε̇0)), held at 1 below ε̇0 so the
-/// logarithm never softens the material (NOTES.md).
+/// logarithm never softens the material (docs/references.md#constitutive-forms).
 #[inline]
 pub fn jc_yield(jc: &JohnsonCook, eps_p: f64, rate: f64, t: f64) -> (f64, f64, f64) {
     let hard = jc.a_pa + jc.b_pa * eps_p.max(0.0).powf(jc.n);

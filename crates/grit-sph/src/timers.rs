@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// The stages of one engine step, in the order `World::step` runs them (DESIGN.md "Engine step").
+/// The stages of one engine step, in the order `World::step` runs them (docs/design.md#the-engine-step).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
     /// Cell-list neighbour search (rebuilt only when the skin is used up).

@@ -1,5 +1,5 @@
 //! Determinism contract: the same scene gives bitwise the same positions, stresses and damage on
-//! 1 thread and on 2 (DESIGN.md "Rules the engine keeps"), with the particles in creation order
+//! 1 thread and on 2 (docs/design.md#rules-the-engine-keeps), with the particles in creation order
 //! and in cell order (`Settings::cell_order`).
 
 use grit_sph::verification::elastic_impact;

@@ -47,9 +47,9 @@ fn campaign_id(raw: &str) -> Result<Uuid> {
         .map_err(|_| Error::NotFound(format!("campaign {raw}")))
 }
 
-/// Submits a campaign (issue 3 campaign spec).
+/// Submits a campaign (the campaign spec of README.md and docs/api.md).
 #[utoipa::path(post, path = "/api/v1/campaigns",
-    request_body(content = Object, description = "campaign spec (issue 3); every field optional"),
+    request_body(content = Object, description = "campaign spec; every field optional"),
     params(("Idempotency-Key" = Option<String>, Header, description = "a retried submit with the same key returns the first campaign")),
     responses((status = 201, body = CampaignCreated), (status = 200, body = CampaignCreated, description = "idempotent replay"),
         (status = 400, body = ErrorBody), (status = 401), (status = 409, body = ErrorBody), (status = 413), (status = 422, body = ErrorBody)),

@@ -109,7 +109,7 @@ impl utoipa::Modify for Resources {
 /// The OpenAPI document of the API.
 #[derive(OpenApi)]
 #[openapi(
-    info(title = "grit coordinator", description = "Campaigns of SPH erosion impacts farmed out to workers (issue 4)."),
+    info(title = "grit coordinator", description = "Campaigns of SPH erosion impacts farmed out to workers."),
     paths(healthz),
     modifiers(&Resources, &Security)
 )]

@@ -2,7 +2,7 @@
 //! half cylinder (E 70 GPa, ν 0.3, R 25 mm, plane strain) is pressed onto a rigid flat by its
 //! top boundary; the peak contact pressure follows eq. 31, the pressure profile eq. 32 and the
 //! stresses on the symmetry axis eq. 33. Hertz's cylinder on a rigid flat in plane strain uses
-//! the contact modulus E* = E / (1 − ν²) (NOTES.md), and so does every comparison here.
+//! the contact modulus E* = E / (1 − ν²) (docs/references.md#contact), and so does every comparison here.
 
 use super::{CaseReport, Chart, Row, Series};
 use crate::body::Motion;
@@ -39,7 +39,7 @@ pub const STIFFNESS_FACTOR: f64 = 4.0;
 /// applied every 40 steps through the ~10⁴ steps of quasi-static loading it diffuses the
 /// pressure peak, which the `hertz_peak_pressure_density_filter` row measures.
 pub const DENSITY_FILTER: u32 = 0;
-/// Bound on the relative error of p0 at the finest spacing (issue 2).
+/// Bound on the relative error of p0 at the finest spacing (docs/design.md#targets).
 pub const P0_BOUND: f64 = 0.05;
 /// Regression bound on the pressure-profile RMS error over p0 (the issue asks for the value
 /// only; measured 0.03–0.04 at 20–50 particles per radius).
@@ -138,7 +138,7 @@ pub fn simulate(n_radius: usize, shepard_interval: u32) -> Result<Vec<Snapshot>,
 }
 
 /// `simulate` with other engine settings (kernel, Courant number, …); their spacing is
-/// replaced by the radius over `n_radius`. For the speed–accuracy sweep of issue 5.
+/// replaced by the radius over `n_radius`. For the speed–accuracy sweep.
 pub fn simulate_with(n_radius: usize, settings: Settings) -> Result<Vec<Snapshot>, SimError> {
     let dx = RADIUS / n_radius as f64;
     let mat = Material::elastic_aluminium();

@@ -1,6 +1,6 @@
 //! Controlled sliding on a flat surface (seed section 3.3.2): a rigid slider pressed down by Fn
 //! and pulled by Ft(t) = 0.8 Fn min(t / 1 s, 1), μ = 0.5. It sticks until Ft = μ Fn at 0.625 s,
-//! then accelerates ever faster until 1 s and at a constant rate after (NOTES.md).
+//! then accelerates ever faster until 1 s and at a constant rate after (docs/references.md#verification).
 
 use super::slope::{OVERLAP, TANGENTIAL_OVER_NORMAL};
 use super::{CaseReport, Chart, Row, Series};
