@@ -1,5 +1,5 @@
-//! The campaign spec (issue 3, "Campaign spec"): what a user submits, its validation, and its
-//! deterministic expansion into cells and jobs (one job = one sample of one cell).
+//! The campaign spec (`docs/design.md`, "Campaign spec"): what a user submits, its validation,
+//! and its deterministic expansion into cells and jobs (one job = one sample of one cell).
 //!
 //! Every field is optional and defaults to the seed paper (section 4): angles 15–90° in 15°
 //! steps, the four shapes of Fig. 7b, 25 samples, 140/70/60 impacts at 15°/30°/other angles,
@@ -27,11 +27,17 @@
 //! a campaign resubmitted years later replays the same grains.
 
 use std::collections::BTreeMap;
+use std::fmt;
+use std::marker::PhantomData;
 
 use grit_sph::Material;
-use serde::de::DeserializeOwned;
-use serde::{Deserialize, Serialize, Serializer};
+use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+use serde::de::{
+    self, DeserializeOwned, DeserializeSeed, IntoDeserializer, MapAccess, SeqAccess, Visitor,
+};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use serde_json::{Map, Value};
+use serde_path_to_error::Segment;
 
 use crate::aggregate::{CellInput, SampleInput};
 use crate::impact::ImpactParams;
@@ -59,7 +65,7 @@ fn err(field: impl Into<String>, rule: impl Into<String>) -> SpecError {
     }
 }
 
-/// One value, or a list of values to sweep over.
+/// One value, or a list of values to sweep over: a JSON value or a JSON array of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep<T>(pub Vec<T>);
 
@@ -89,6 +95,49 @@ impl<T: Serialize> Serialize for Sweep<T> {
     }
 }
 
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Sweep<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        one_or_many(d).map(Sweep)
+    }
+}
+
+/// A single value or an array of values. Each kind of JSON value goes straight to `T`, never
+/// through a buffer, so an error inside keeps its path (`velocity_m_s[1]`) and serde's message.
+fn one_or_many<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
+    struct OneOrMany<T>(PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> Visitor<'de> for OneOrMany<T> {
+        type Value = Vec<T>;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("a value or an array of values")
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Vec<T>, A::Error> {
+            Vec::deserialize(SeqAccessDeserializer::new(seq))
+        }
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Vec<T>, A::Error> {
+            T::deserialize(MapAccessDeserializer::new(map)).map(|v| vec![v])
+        }
+        fn visit_str<E: de::Error>(self, v: &str) -> Result<Vec<T>, E> {
+            T::deserialize(v.into_deserializer()).map(|v| vec![v])
+        }
+        fn visit_bool<E: de::Error>(self, v: bool) -> Result<Vec<T>, E> {
+            T::deserialize(v.into_deserializer()).map(|v| vec![v])
+        }
+        fn visit_i64<E: de::Error>(self, v: i64) -> Result<Vec<T>, E> {
+            T::deserialize(v.into_deserializer()).map(|v| vec![v])
+        }
+        fn visit_u64<E: de::Error>(self, v: u64) -> Result<Vec<T>, E> {
+            T::deserialize(v.into_deserializer()).map(|v| vec![v])
+        }
+        fn visit_f64<E: de::Error>(self, v: f64) -> Result<Vec<T>, E> {
+            T::deserialize(v.into_deserializer()).map(|v| vec![v])
+        }
+        fn visit_unit<E: de::Error>(self) -> Result<Vec<T>, E> {
+            T::deserialize(().into_deserializer()).map(|v| vec![v])
+        }
+    }
+    d.deserialize_any(OneOrMany(PhantomData))
+}
+
 /// The surface material: `"aisi304"` or a full `grit_sph::Material` object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MaterialSpec(pub Material);
@@ -103,22 +152,27 @@ impl Serialize for MaterialSpec {
     }
 }
 
-impl MaterialSpec {
-    fn from_value(v: Value, field: &str) -> Result<Self, SpecError> {
-        match v {
-            Value::String(name) if name == "aisi304" => Ok(MaterialSpec(Material::aisi304())),
-            Value::String(name) => Err(err(
-                field,
-                format!("unknown material `{name}`; expected \"aisi304\" or an object of Johnson–Cook and elastic constants"),
-            )),
-            Value::Object(_) => serde_json::from_value(v)
-                .map(MaterialSpec)
-                .map_err(|e| err(field, e.to_string())),
-            other => Err(err(
-                field,
-                format!("expected \"aisi304\" or a material object, got {other}"),
-            )),
+impl<'de> Deserialize<'de> for MaterialSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct MaterialVisitor;
+        impl<'de> Visitor<'de> for MaterialVisitor {
+            type Value = MaterialSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("\"aisi304\" or a material object")
+            }
+            fn visit_str<E: de::Error>(self, name: &str) -> Result<MaterialSpec, E> {
+                match name {
+                    "aisi304" => Ok(MaterialSpec(Material::aisi304())),
+                    _ => Err(E::custom(format!(
+                        "unknown material `{name}`; expected \"aisi304\" or an object of Johnson–Cook and elastic constants"
+                    ))),
+                }
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<MaterialSpec, A::Error> {
+                Material::deserialize(MapAccessDeserializer::new(map)).map(MaterialSpec)
+            }
         }
+        d.deserialize_any(MaterialVisitor)
     }
 }
 
@@ -158,41 +212,6 @@ impl Impacts {
                 .or(*default),
         }
     }
-
-    fn from_value(v: Value) -> Result<Self, SpecError> {
-        match v {
-            Value::Number(_) => Ok(Impacts::All(count(&v, "impacts")?)),
-            Value::Object(map) => {
-                let mut angles = Vec::new();
-                let mut default = None;
-                for (k, n) in map {
-                    let field = format!("impacts[\"{k}\"]");
-                    let n = count(&n, &field)?;
-                    if k == "default" {
-                        default = Some(n);
-                        continue;
-                    }
-                    let a: f64 = k.trim().parse().map_err(|_| {
-                        err(
-                            &field,
-                            "keys must be angles in degrees (e.g. \"15\") or \"default\"",
-                        )
-                    })?;
-                    if angles.iter().any(|(b, _)| same_angle(*b, a)) {
-                        return Err(err(&field, "angle listed twice"));
-                    }
-                    angles.push((a, n));
-                }
-                Ok(Impacts::PerAngle { angles, default })
-            }
-            other => Err(err(
-                "impacts",
-                format!(
-                    "expected a number or an object {{\"15\": 140, \"default\": 60}}, got {other}"
-                ),
-            )),
-        }
-    }
 }
 
 impl Serialize for Impacts {
@@ -213,20 +232,92 @@ impl Serialize for Impacts {
     }
 }
 
+impl<'de> Deserialize<'de> for Impacts {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct ImpactsVisitor;
+        impl<'de> Visitor<'de> for ImpactsVisitor {
+            type Value = Impacts;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number or an object {\"15\": 140, \"default\": 60}")
+            }
+            fn visit_u64<E: de::Error>(self, n: u64) -> Result<Impacts, E> {
+                u32::try_from(n)
+                    .map(Impacts::All)
+                    .map_err(|_| E::custom(not_a_count(n)))
+            }
+            fn visit_i64<E: de::Error>(self, n: i64) -> Result<Impacts, E> {
+                match u64::try_from(n) {
+                    Ok(n) => self.visit_u64(n),
+                    Err(_) => Err(E::custom(not_a_count(n))),
+                }
+            }
+            fn visit_f64<E: de::Error>(self, x: f64) -> Result<Impacts, E> {
+                Err(E::custom(not_a_count(Value::from(x))))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Impacts, A::Error> {
+                let (mut angles, mut default) = (Vec::new(), None);
+                while let Some(key) = map.next_key::<String>()? {
+                    map.next_value_seed(AngleEntry {
+                        key: &key,
+                        angles: &mut angles,
+                        default: &mut default,
+                    })?;
+                }
+                Ok(Impacts::PerAngle { angles, default })
+            }
+        }
+        d.deserialize_any(ImpactsVisitor)
+    }
+}
+
+/// One entry of the per-angle impacts map. The key is checked while its value is read, so an
+/// error about the key names it too (`impacts["fifteen"]`).
+struct AngleEntry<'a> {
+    key: &'a str,
+    angles: &'a mut Vec<(f64, u32)>,
+    default: &'a mut Option<u32>,
+}
+
+impl<'de> DeserializeSeed<'de> for AngleEntry<'_> {
+    type Value = ();
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        let n = count(d)?;
+        if self.key == "default" {
+            *self.default = Some(n);
+            return Ok(());
+        }
+        let a: f64 = self.key.trim().parse().map_err(|_| {
+            de::Error::custom("keys must be angles in degrees (e.g. \"15\") or \"default\"")
+        })?;
+        if self.angles.iter().any(|(b, _)| same_angle(*b, a)) {
+            return Err(de::Error::custom("angle listed twice"));
+        }
+        self.angles.push((a, n));
+        Ok(())
+    }
+}
+
 /// Angles from JSON keys ("15") and values (15.0) are compared to a tolerance far below any
 /// meaningful difference in impact angle.
 fn same_angle(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
 }
 
-fn count(v: &Value, field: &str) -> Result<u32, SpecError> {
+fn not_a_count(v: impl fmt::Display) -> String {
+    format!("must be a whole number ≥ 0, got {v}")
+}
+
+/// A count (`samples`, impacts): a whole number that fits in u32.
+fn count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let v = Value::deserialize(d)?;
     v.as_u64()
         .and_then(|n| u32::try_from(n).ok())
-        .ok_or_else(|| err(field, format!("must be a whole number ≥ 0, got {v}")))
+        .ok_or_else(|| de::Error::custom(not_a_count(&v)))
 }
 
 /// The grain: diameter Dg (grains have the area of a circle of this diameter) and density.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct GrainSpec {
     /// Grain diameter Dg in metres (seed: 250 µm); sweepable.
     pub diameter_m: Sweep<f64>,
@@ -246,21 +337,24 @@ impl Default for GrainSpec {
 
 /// A campaign as submitted (`grit submit`, `POST /api/v1/campaigns`, `grit run`).
 ///
-/// Deserialise it with `CampaignSpec::from_json` or serde (`try_from` a JSON value): both
-/// reject unknown fields by name and name the field of any value of the wrong type. Semantic
-/// rules (ranges, counts) are checked by `validate`, which `expand` runs first.
+/// Deserialise it with `CampaignSpec::from_json`, which names every unknown field at once and
+/// the path of any value of the wrong type, or with plain serde, which stops at the first.
+/// Semantic rules (ranges, counts) are checked by `validate`, which `expand` runs first.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "Value")]
+#[serde(deny_unknown_fields, default)]
 pub struct CampaignSpec {
     /// Free-text name shown in listings.
     pub name: Option<String>,
     /// Seed of the whole campaign; every job's seed derives from it (module docs).
     pub seed: u64,
-    /// Impact angles in degrees, each in (0, 90].
+    /// Impact angles in degrees, each in (0, 90]; one number or an array.
+    #[serde(deserialize_with = "one_or_many")]
     pub angles_deg: Vec<f64>,
-    /// Grain shapes: built-in names or `{name, vertices_m}` polygons.
+    /// Grain shapes: built-in names or `{name, vertices_m}` polygons; one or an array.
+    #[serde(deserialize_with = "one_or_many")]
     pub shapes: Vec<Shape>,
     /// Samples per cell.
+    #[serde(deserialize_with = "count")]
     pub samples: u32,
     /// Impacts per sample, per angle.
     pub impacts: Impacts,
@@ -312,27 +406,39 @@ impl Default for CampaignSpec {
     }
 }
 
-const TOP_FIELDS: [&str; 16] = [
-    "name",
-    "seed",
-    "angles_deg",
-    "shapes",
-    "samples",
-    "impacts",
-    "velocity_m_s",
-    "grain",
-    "spacing_m",
-    "distribution_range_dg",
-    "material",
-    "friction",
-    "surface_width_dg",
-    "surface_depth_dg",
-    "settle_fraction",
-    "allow_short_samples",
-];
-const GRAIN_FIELDS: [&str; 2] = ["diameter_m", "density_kg_m3"];
+/// The field names serde derives for the struct `T`: asks its `Deserialize` for them without
+/// any data, so the list of known fields is never written by hand.
+fn field_names<T: DeserializeOwned>() -> &'static [&'static str] {
+    struct Probe<'a>(&'a mut &'static [&'static str]);
+    impl<'de> Deserializer<'de> for Probe<'_> {
+        type Error = de::value::Error;
+        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, Self::Error> {
+            Err(de::Error::custom("not a struct"))
+        }
+        fn deserialize_struct<V: Visitor<'de>>(
+            self,
+            _: &'static str,
+            fields: &'static [&'static str],
+            _: V,
+        ) -> Result<V::Value, Self::Error> {
+            *self.0 = fields;
+            Err(de::Error::custom("field names taken"))
+        }
+        serde::forward_to_deserialize_any! {
+            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes
+            byte_buf option unit unit_struct newtype_struct seq tuple tuple_struct map enum
+            identifier ignored_any
+        }
+    }
+    let mut names: &'static [&'static str] = &[];
+    let _ = T::deserialize(Probe(&mut names));
+    names
+}
 
-fn reject_unknown(map: &Map<String, Value>, known: &[&str], prefix: &str) -> Result<(), SpecError> {
+/// Every key of `map` that is not a field of `T`, named together with the known ones, so a
+/// user sees all their typos at once (serde stops at the first).
+fn reject_unknown<T: DeserializeOwned>(map: &Map<String, Value>, prefix: &str) -> Result<(), SpecError> {
+    let known = field_names::<T>();
     let unknown: Vec<String> = map
         .keys()
         .filter(|k| !known.contains(&k.as_str()))
@@ -351,110 +457,27 @@ fn reject_unknown(map: &Map<String, Value>, known: &[&str], prefix: &str) -> Res
     ))
 }
 
-fn typed<T: DeserializeOwned>(v: Value, field: &str) -> Result<T, SpecError> {
-    serde_json::from_value(v).map_err(|e| err(field, e.to_string()))
-}
-
-fn sweep_f64(v: Value, field: &str) -> Result<Sweep<f64>, SpecError> {
-    match v {
-        Value::Array(items) => items
-            .into_iter()
-            .enumerate()
-            .map(|(i, x)| typed(x, &format!("{field}[{i}]")))
-            .collect::<Result<_, _>>()
-            .map(Sweep),
-        one => typed(one, field).map(Sweep::one),
+/// The spec field a deserialisation error points at, written as users write it:
+/// `grain.diameter_m[1]`, and the angle keys of `impacts` quoted, `impacts["15"]`.
+fn field_path(path: &serde_path_to_error::Path) -> String {
+    let mut out = String::new();
+    for segment in path.iter() {
+        match segment {
+            Segment::Seq { index } => out.push_str(&format!("[{index}]")),
+            Segment::Map { key } if out == "impacts" => out.push_str(&format!("[\"{key}\"]")),
+            Segment::Map { key } | Segment::Enum { variant: key } => {
+                if !out.is_empty() {
+                    out.push('.');
+                }
+                out.push_str(key);
+            }
+            Segment::Unknown => out.push_str(if out.is_empty() { "?" } else { ".?" }),
+        }
     }
-}
-
-impl TryFrom<Value> for CampaignSpec {
-    type Error = SpecError;
-
-    fn try_from(v: Value) -> Result<Self, SpecError> {
-        let Value::Object(mut map) = v else {
-            return Err(err("(campaign)", "must be a JSON object"));
-        };
-        reject_unknown(&map, &TOP_FIELDS, "")?;
-        let mut spec = CampaignSpec::default();
-        let mut take = |k: &str| map.remove(k).filter(|v| !v.is_null());
-        if let Some(v) = take("name") {
-            spec.name = Some(typed(v, "name")?);
-        }
-        if let Some(v) = take("seed") {
-            spec.seed = typed(v, "seed")?;
-        }
-        if let Some(v) = take("angles_deg") {
-            spec.angles_deg = sweep_f64(v, "angles_deg")?.0;
-        }
-        if let Some(v) = take("shapes") {
-            let items = match v {
-                Value::Array(items) => items,
-                one => vec![one],
-            };
-            spec.shapes = items
-                .into_iter()
-                .enumerate()
-                .map(|(i, s)| typed(s, &format!("shapes[{i}]")))
-                .collect::<Result<_, _>>()?;
-        }
-        if let Some(v) = take("samples") {
-            spec.samples = count(&v, "samples")?;
-        }
-        if let Some(v) = take("impacts") {
-            spec.impacts = Impacts::from_value(v)?;
-        }
-        if let Some(v) = take("velocity_m_s") {
-            spec.velocity_m_s = sweep_f64(v, "velocity_m_s")?;
-        }
-        if let Some(v) = take("grain") {
-            let Value::Object(mut g) = v else {
-                return Err(err(
-                    "grain",
-                    "must be an object {\"diameter_m\", \"density_kg_m3\"}",
-                ));
-            };
-            reject_unknown(&g, &GRAIN_FIELDS, "grain.")?;
-            if let Some(d) = g.remove("diameter_m") {
-                spec.grain.diameter_m = sweep_f64(d, "grain.diameter_m")?;
-            }
-            if let Some(d) = g.remove("density_kg_m3") {
-                spec.grain.density_kg_m3 = sweep_f64(d, "grain.density_kg_m3")?;
-            }
-        }
-        if let Some(v) = take("spacing_m") {
-            spec.spacing_m = sweep_f64(v, "spacing_m")?;
-        }
-        if let Some(v) = take("distribution_range_dg") {
-            spec.distribution_range_dg = sweep_f64(v, "distribution_range_dg")?;
-        }
-        if let Some(v) = take("material") {
-            spec.material = match v {
-                Value::Array(items) => Sweep(
-                    items
-                        .into_iter()
-                        .enumerate()
-                        .map(|(i, m)| MaterialSpec::from_value(m, &format!("material[{i}]")))
-                        .collect::<Result<_, _>>()?,
-                ),
-                one => Sweep::one(MaterialSpec::from_value(one, "material")?),
-            };
-        }
-        if let Some(v) = take("friction") {
-            spec.friction = typed(v, "friction")?;
-        }
-        if let Some(v) = take("surface_width_dg") {
-            spec.surface_width_dg = typed(v, "surface_width_dg")?;
-        }
-        if let Some(v) = take("surface_depth_dg") {
-            spec.surface_depth_dg = typed(v, "surface_depth_dg")?;
-        }
-        if let Some(v) = take("settle_fraction") {
-            spec.settle_fraction = typed(v, "settle_fraction")?;
-        }
-        if let Some(v) = take("allow_short_samples") {
-            spec.allow_short_samples = typed(v, "allow_short_samples")?;
-        }
-        Ok(spec)
+    if out.is_empty() {
+        "(campaign)".into()
+    } else {
+        out
     }
 }
 
@@ -521,10 +544,21 @@ fn spec_field(params_field: &str, sweeps: &[(&str, usize, bool)]) -> String {
 }
 
 impl CampaignSpec {
-    /// Parses JSON text; errors name the field (`JSON syntax` for text that is not JSON).
+    /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
+    /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
     pub fn from_json(text: &str) -> Result<CampaignSpec, SpecError> {
         let v: Value = serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))?;
-        CampaignSpec::try_from(v)
+        let Value::Object(mut map) = v else {
+            return Err(err("(campaign)", "must be a JSON object"));
+        };
+        map.retain(|_, v| !v.is_null());
+        reject_unknown::<CampaignSpec>(&map, "")?;
+        if let Some(Value::Object(grain)) = map.get("grain") {
+            reject_unknown::<GrainSpec>(grain, "grain.")?;
+        }
+        let v = Value::Object(map);
+        serde_path_to_error::deserialize(&v)
+            .map_err(|e| err(field_path(e.path()), e.into_inner().to_string()))
     }
 
     /// Checks every rule; the error names the field and the rule.

@@ -835,9 +835,9 @@ fn bench_impact(scene: ImpactScene, threads: usize, repeat: usize, json: bool) -
         spacing_m,
         ..ImpactParams::paper(angle, Shape::Hexagon)
     };
-    params.numerics.grain_shell &= !full_grain;
+    params.numerics.engine.rigid_shell &= !full_grain;
     params.numerics.skip_flight &= !full_flight;
-    params.numerics.cell_order |= cell_order;
+    params.numerics.engine.cell_order |= cell_order;
     params
         .validate()
         .map_err(|e| CliError(format!("{}: {}", e.field, e.rule)))?;

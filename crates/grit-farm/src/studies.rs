@@ -137,10 +137,10 @@ pub fn stability(a: &StabilityArgs) -> Result<Vec<StabilityPoint>, String> {
     for (panel, n) in todo {
         pb.set_message(format!(
             "{:?}: cfl {} α {} k×{} {:?}",
-            panel, n.cfl, n.hourglass, n.contact_stiffness_scale, n.contact_model
+            panel, n.engine.cfl, n.engine.hourglass, n.contact_stiffness_scale, n.contact_model
         ));
         let p =
-            stability::run_point(&from, panel, n, a.budget_factor).map_err(|e| e.to_string())?;
+            stability::run_point(&from, panel, n.clone(), a.budget_factor).map_err(|e| e.to_string())?;
         pb.inc(1);
         progress_line(
             &pb,
@@ -149,8 +149,8 @@ pub fn stability(a: &StabilityArgs) -> Result<Vec<StabilityPoint>, String> {
                 pb.position(),
                 pb.length().unwrap_or(0),
                 panel,
-                n.cfl,
-                n.hourglass,
+                n.engine.cfl,
+                n.engine.hourglass,
                 n.contact_stiffness_scale,
                 p.verdict,
                 p.failure
