@@ -3,9 +3,9 @@
 //! surface has settled.
 
 use grit_sph::{
-    cfl_matched_stiffness, contact::ContactModel, neighbours, particles::KINEMATIC, Absorber, ContactParams,
-    InputError, KernelKind, Material, Motion, Particles, Polygon, Settings, SimError, Timers,
-    Vector, World,
+    cfl_matched_stiffness, contact::ContactModel, neighbours, particles::KINEMATIC, Absorber,
+    ContactParams, InputError, KernelKind, Material, Motion, Particles, Polygon, Settings,
+    SimError, Timers, Vector, World,
 };
 use serde::{Deserialize, Serialize};
 
@@ -844,4 +844,24 @@ pub fn free_particles(surface: &Particles) -> usize {
         .iter()
         .filter(|&&f| f & KINEMATIC == 0)
         .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numerics_keep_their_json_keys() {
+        // Scenes are stored (farm cells, checkpoints) and compared as this JSON.
+        let n = Numerics::default();
+        let json = serde_json::to_string(&n).unwrap();
+        assert_eq!(
+            json,
+            r#"{"kernel":"quintic","cfl":0.3,"hourglass":0.1,"contact_model":"extrapolated","contact_stiffness_scale":1.0,"contact_limits_dt":true,"grain_shell":true,"skip_flight":true,"cell_order":false,"absorbing_layers":0.0}"#
+        );
+        assert_eq!(serde_json::from_str::<Numerics>(&json).unwrap(), n);
+        let n: Numerics = serde_json::from_str(r#"{"cfl": 0.2, "grain_shell": false}"#).unwrap();
+        assert_eq!((n.engine.cfl, n.engine.rigid_shell), (0.2, false));
+        assert!(serde_json::from_str::<Numerics>(r#"{"h_over_dx": 1.5}"#).is_err());
+    }
 }

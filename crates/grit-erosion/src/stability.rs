@@ -402,7 +402,8 @@ mod tests {
         assert!(pts
             .iter()
             .filter(|(p, _)| *p == Panel::StiffnessStepPenetration)
-            .all(|(_, n)| n.contact_model == ContactModel::Penetration && !n.engine.contact_limits_dt));
+            .all(|(_, n)| n.contact_model == ContactModel::Penetration
+                && !n.engine.contact_limits_dt));
         let bad = StabilityGrid {
             cfl: vec![0.3, 2.5],
             ..g.clone()

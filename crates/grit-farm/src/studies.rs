@@ -139,8 +139,8 @@ pub fn stability(a: &StabilityArgs) -> Result<Vec<StabilityPoint>, String> {
             "{:?}: cfl {} α {} k×{} {:?}",
             panel, n.engine.cfl, n.engine.hourglass, n.contact_stiffness_scale, n.contact_model
         ));
-        let p =
-            stability::run_point(&from, panel, n.clone(), a.budget_factor).map_err(|e| e.to_string())?;
+        let p = stability::run_point(&from, panel, n.clone(), a.budget_factor)
+            .map_err(|e| e.to_string())?;
         pb.inc(1);
         progress_line(
             &pb,
