@@ -246,10 +246,24 @@ pub fn validate_polygon(v: &[[f64; 2]], field: &str) -> Result<(), InputError> {
             return invalid(format!("vertices {i} and {} coincide", (i + 1) % n));
         }
     }
+    // Two non-adjacent edges that touch; a zero area with such a pair is a crossing (a bow
+    // tie), one without is collinear vertices.
+    let crossing = (0..n)
+        .flat_map(|i| (i + 2..n).map(move |j| (i, j)))
+        .filter(|&(i, j)| !(i == 0 && j == n - 1))
+        .find(|&(i, j)| segments_intersect(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]));
+    let crossed = |(i, j): (usize, usize)| {
+        invalid(format!(
+            "polygon is self-intersecting: edges {i} and {j} intersect; it must be simple"
+        ))
+    };
     let (lo, hi) = bbox(&v);
     let extent = (hi - lo).max();
     if signed_area(&v).abs() <= ZERO_AREA_TOLERANCE * extent * extent {
-        return invalid("area is zero: the vertices are collinear".into());
+        return match crossing {
+            Some(pair) => crossed(pair),
+            None => invalid("area is zero: the vertices are collinear".into()),
+        };
     }
     for i in 0..n {
         let (a, b, c) = (v[i], v[(i + 1) % n], v[(i + 2) % n]);
@@ -260,17 +274,8 @@ pub fn validate_polygon(v: &[[f64; 2]], field: &str) -> Result<(), InputError> {
             ));
         }
     }
-    for i in 0..n {
-        for j in i + 2..n {
-            if i == 0 && j == n - 1 {
-                continue; // adjacent through vertex 0
-            }
-            if segments_intersect(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]) {
-                return invalid(format!(
-                    "polygon is self-intersecting: edges {i} and {j} intersect; it must be simple"
-                ));
-            }
-        }
+    if let Some(pair) = crossing {
+        return crossed(pair);
     }
     Ok(())
 }
