@@ -296,9 +296,9 @@ fn impact(
         bail!("--repeat: must be at least 1");
     }
     let mut params = studies::scene(angle, spacing_m);
-    params.numerics.grain_shell &= !full_grain;
+    params.numerics.engine.rigid_shell &= !full_grain;
     params.numerics.skip_flight &= !full_flight;
-    params.numerics.cell_order |= cell_order;
+    params.numerics.engine.cell_order |= cell_order;
     params.validate()?;
     let mut s = Sample::new(params, seed)?;
     for k in 0..after {
@@ -371,7 +371,7 @@ fn stability_map(study: &StabilityStudy, out: &std::path::Path) -> anyhow::Resul
     let points = study.run(|event| match event {
         StabilityProgress::Start { panel, numerics: n } => pb.set_message(format!(
             "{:?}: cfl {} α {} k×{} {:?}",
-            panel, n.cfl, n.hourglass, n.contact_stiffness_scale, n.contact_model
+            panel, n.engine.cfl, n.engine.hourglass, n.contact_stiffness_scale, n.contact_model
         )),
         StabilityProgress::Done {
             panel,
@@ -385,8 +385,8 @@ fn stability_map(study: &StabilityStudy, out: &std::path::Path) -> anyhow::Resul
                     "{}/{total} {:?}: cfl {} α {} k×{}: {:?}{}",
                     pb.position(),
                     panel,
-                    n.cfl,
-                    n.hourglass,
+                    n.engine.cfl,
+                    n.engine.hourglass,
                     n.contact_stiffness_scale,
                     p.verdict,
                     p.failure

@@ -1,5 +1,5 @@
-//! The campaign spec (issue 3, "Campaign spec"): what a user submits, its validation, and its
-//! deterministic expansion into cells and jobs (one job = one sample of one cell).
+//! The campaign spec (`docs/design.md`, "Campaign spec"): what a user submits, its validation,
+//! and its deterministic expansion into cells and jobs (one job = one sample of one cell).
 //!
 //! Every field is optional and defaults to the seed paper (section 4): angles 15–90° in 15°
 //! steps, the four shapes of Fig. 7b, 25 samples, 140/70/60 impacts at 15°/30°/other angles,
@@ -29,13 +29,15 @@
 use std::collections::BTreeMap;
 
 use grit_sph::Material;
-use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize, Serializer};
 use serde_json::{Map, Value};
 
 use crate::aggregate::{CellInput, SampleInput};
 use crate::impact::ImpactParams;
 use crate::shapes::Shape;
+
+mod json;
+use json::{count, field_path, one_or_many, reject_unknown};
 
 /// Fewest impacts a sample may be planned with: the slope window (20) plus one.
 pub const MIN_IMPACTS: u32 = 21;
@@ -59,7 +61,7 @@ fn err(field: impl Into<String>, rule: impl Into<String>) -> SpecError {
     }
 }
 
-/// One value, or a list of values to sweep over.
+/// One value, or a list of values to sweep over: a JSON value or a JSON array of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep<T>(pub Vec<T>);
 
@@ -103,25 +105,6 @@ impl Serialize for MaterialSpec {
     }
 }
 
-impl MaterialSpec {
-    fn from_value(v: Value, field: &str) -> Result<Self, SpecError> {
-        match v {
-            Value::String(name) if name == "aisi304" => Ok(MaterialSpec(Material::aisi304())),
-            Value::String(name) => Err(err(
-                field,
-                format!("unknown material `{name}`; expected \"aisi304\" or an object of Johnson–Cook and elastic constants"),
-            )),
-            Value::Object(_) => serde_json::from_value(v)
-                .map(MaterialSpec)
-                .map_err(|e| err(field, e.to_string())),
-            other => Err(err(
-                field,
-                format!("expected \"aisi304\" or a material object, got {other}"),
-            )),
-        }
-    }
-}
-
 /// Impacts per sample: one number for every angle, or per angle with a `default`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Impacts {
@@ -158,41 +141,6 @@ impl Impacts {
                 .or(*default),
         }
     }
-
-    fn from_value(v: Value) -> Result<Self, SpecError> {
-        match v {
-            Value::Number(_) => Ok(Impacts::All(count(&v, "impacts")?)),
-            Value::Object(map) => {
-                let mut angles = Vec::new();
-                let mut default = None;
-                for (k, n) in map {
-                    let field = format!("impacts[\"{k}\"]");
-                    let n = count(&n, &field)?;
-                    if k == "default" {
-                        default = Some(n);
-                        continue;
-                    }
-                    let a: f64 = k.trim().parse().map_err(|_| {
-                        err(
-                            &field,
-                            "keys must be angles in degrees (e.g. \"15\") or \"default\"",
-                        )
-                    })?;
-                    if angles.iter().any(|(b, _)| same_angle(*b, a)) {
-                        return Err(err(&field, "angle listed twice"));
-                    }
-                    angles.push((a, n));
-                }
-                Ok(Impacts::PerAngle { angles, default })
-            }
-            other => Err(err(
-                "impacts",
-                format!(
-                    "expected a number or an object {{\"15\": 140, \"default\": 60}}, got {other}"
-                ),
-            )),
-        }
-    }
 }
 
 impl Serialize for Impacts {
@@ -219,14 +167,9 @@ fn same_angle(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
 }
 
-fn count(v: &Value, field: &str) -> Result<u32, SpecError> {
-    v.as_u64()
-        .and_then(|n| u32::try_from(n).ok())
-        .ok_or_else(|| err(field, format!("must be a whole number ≥ 0, got {v}")))
-}
-
 /// The grain: diameter Dg (grains have the area of a circle of this diameter) and density.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct GrainSpec {
     /// Grain diameter Dg in metres (seed: 250 µm); sweepable.
     pub diameter_m: Sweep<f64>,
@@ -246,21 +189,24 @@ impl Default for GrainSpec {
 
 /// A campaign as submitted (`grit submit`, `POST /api/v1/campaigns`, `grit run`).
 ///
-/// Deserialise it with `CampaignSpec::from_json` or serde (`try_from` a JSON value): both
-/// reject unknown fields by name and name the field of any value of the wrong type. Semantic
-/// rules (ranges, counts) are checked by `validate`, which `expand` runs first.
+/// Deserialise it with `CampaignSpec::from_json`, which names every unknown field at once and
+/// the path of any value of the wrong type, or with plain serde, which stops at the first.
+/// Semantic rules (ranges, counts) are checked by `validate`, which `expand` runs first.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "Value")]
+#[serde(deny_unknown_fields, default)]
 pub struct CampaignSpec {
     /// Free-text name shown in listings.
     pub name: Option<String>,
     /// Seed of the whole campaign; every job's seed derives from it (module docs).
     pub seed: u64,
-    /// Impact angles in degrees, each in (0, 90].
+    /// Impact angles in degrees, each in (0, 90]; one number or an array.
+    #[serde(deserialize_with = "one_or_many")]
     pub angles_deg: Vec<f64>,
-    /// Grain shapes: built-in names or `{name, vertices_m}` polygons.
+    /// Grain shapes: built-in names or `{name, vertices_m}` polygons; one or an array.
+    #[serde(deserialize_with = "one_or_many")]
     pub shapes: Vec<Shape>,
     /// Samples per cell.
+    #[serde(deserialize_with = "count")]
     pub samples: u32,
     /// Impacts per sample, per angle.
     pub impacts: Impacts,
@@ -309,152 +255,6 @@ impl Default for CampaignSpec {
             settle_fraction: p.settle_fraction,
             allow_short_samples: false,
         }
-    }
-}
-
-const TOP_FIELDS: [&str; 16] = [
-    "name",
-    "seed",
-    "angles_deg",
-    "shapes",
-    "samples",
-    "impacts",
-    "velocity_m_s",
-    "grain",
-    "spacing_m",
-    "distribution_range_dg",
-    "material",
-    "friction",
-    "surface_width_dg",
-    "surface_depth_dg",
-    "settle_fraction",
-    "allow_short_samples",
-];
-const GRAIN_FIELDS: [&str; 2] = ["diameter_m", "density_kg_m3"];
-
-fn reject_unknown(map: &Map<String, Value>, known: &[&str], prefix: &str) -> Result<(), SpecError> {
-    let unknown: Vec<String> = map
-        .keys()
-        .filter(|k| !known.contains(&k.as_str()))
-        .map(|k| format!("{prefix}{k}"))
-        .collect();
-    if unknown.is_empty() {
-        return Ok(());
-    }
-    Err(err(
-        unknown.join(", "),
-        format!(
-            "unknown field{}; known fields: {}",
-            if unknown.len() > 1 { "s" } else { "" },
-            known.join(", ")
-        ),
-    ))
-}
-
-fn typed<T: DeserializeOwned>(v: Value, field: &str) -> Result<T, SpecError> {
-    serde_json::from_value(v).map_err(|e| err(field, e.to_string()))
-}
-
-fn sweep_f64(v: Value, field: &str) -> Result<Sweep<f64>, SpecError> {
-    match v {
-        Value::Array(items) => items
-            .into_iter()
-            .enumerate()
-            .map(|(i, x)| typed(x, &format!("{field}[{i}]")))
-            .collect::<Result<_, _>>()
-            .map(Sweep),
-        one => typed(one, field).map(Sweep::one),
-    }
-}
-
-impl TryFrom<Value> for CampaignSpec {
-    type Error = SpecError;
-
-    fn try_from(v: Value) -> Result<Self, SpecError> {
-        let Value::Object(mut map) = v else {
-            return Err(err("(campaign)", "must be a JSON object"));
-        };
-        reject_unknown(&map, &TOP_FIELDS, "")?;
-        let mut spec = CampaignSpec::default();
-        let mut take = |k: &str| map.remove(k).filter(|v| !v.is_null());
-        if let Some(v) = take("name") {
-            spec.name = Some(typed(v, "name")?);
-        }
-        if let Some(v) = take("seed") {
-            spec.seed = typed(v, "seed")?;
-        }
-        if let Some(v) = take("angles_deg") {
-            spec.angles_deg = sweep_f64(v, "angles_deg")?.0;
-        }
-        if let Some(v) = take("shapes") {
-            let items = match v {
-                Value::Array(items) => items,
-                one => vec![one],
-            };
-            spec.shapes = items
-                .into_iter()
-                .enumerate()
-                .map(|(i, s)| typed(s, &format!("shapes[{i}]")))
-                .collect::<Result<_, _>>()?;
-        }
-        if let Some(v) = take("samples") {
-            spec.samples = count(&v, "samples")?;
-        }
-        if let Some(v) = take("impacts") {
-            spec.impacts = Impacts::from_value(v)?;
-        }
-        if let Some(v) = take("velocity_m_s") {
-            spec.velocity_m_s = sweep_f64(v, "velocity_m_s")?;
-        }
-        if let Some(v) = take("grain") {
-            let Value::Object(mut g) = v else {
-                return Err(err(
-                    "grain",
-                    "must be an object {\"diameter_m\", \"density_kg_m3\"}",
-                ));
-            };
-            reject_unknown(&g, &GRAIN_FIELDS, "grain.")?;
-            if let Some(d) = g.remove("diameter_m") {
-                spec.grain.diameter_m = sweep_f64(d, "grain.diameter_m")?;
-            }
-            if let Some(d) = g.remove("density_kg_m3") {
-                spec.grain.density_kg_m3 = sweep_f64(d, "grain.density_kg_m3")?;
-            }
-        }
-        if let Some(v) = take("spacing_m") {
-            spec.spacing_m = sweep_f64(v, "spacing_m")?;
-        }
-        if let Some(v) = take("distribution_range_dg") {
-            spec.distribution_range_dg = sweep_f64(v, "distribution_range_dg")?;
-        }
-        if let Some(v) = take("material") {
-            spec.material = match v {
-                Value::Array(items) => Sweep(
-                    items
-                        .into_iter()
-                        .enumerate()
-                        .map(|(i, m)| MaterialSpec::from_value(m, &format!("material[{i}]")))
-                        .collect::<Result<_, _>>()?,
-                ),
-                one => Sweep::one(MaterialSpec::from_value(one, "material")?),
-            };
-        }
-        if let Some(v) = take("friction") {
-            spec.friction = typed(v, "friction")?;
-        }
-        if let Some(v) = take("surface_width_dg") {
-            spec.surface_width_dg = typed(v, "surface_width_dg")?;
-        }
-        if let Some(v) = take("surface_depth_dg") {
-            spec.surface_depth_dg = typed(v, "surface_depth_dg")?;
-        }
-        if let Some(v) = take("settle_fraction") {
-            spec.settle_fraction = typed(v, "settle_fraction")?;
-        }
-        if let Some(v) = take("allow_short_samples") {
-            spec.allow_short_samples = typed(v, "allow_short_samples")?;
-        }
-        Ok(spec)
     }
 }
 
@@ -521,10 +321,21 @@ fn spec_field(params_field: &str, sweeps: &[(&str, usize, bool)]) -> String {
 }
 
 impl CampaignSpec {
-    /// Parses JSON text; errors name the field (`JSON syntax` for text that is not JSON).
+    /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
+    /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
     pub fn from_json(text: &str) -> Result<CampaignSpec, SpecError> {
         let v: Value = serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))?;
-        CampaignSpec::try_from(v)
+        let Value::Object(mut map) = v else {
+            return Err(err("(campaign)", "must be a JSON object"));
+        };
+        map.retain(|_, v| !v.is_null());
+        reject_unknown::<CampaignSpec>(&map, "")?;
+        if let Some(Value::Object(grain)) = map.get("grain") {
+            reject_unknown::<GrainSpec>(grain, "grain.")?;
+        }
+        let v = Value::Object(map);
+        serde_path_to_error::deserialize(&v)
+            .map_err(|e| err(field_path(e.path()), e.into_inner().to_string()))
     }
 
     /// Checks every rule; the error names the field and the rule.
@@ -930,6 +741,45 @@ mod tests {
         );
         assert_eq!(field_of("[1, 2]"), "(campaign)");
         assert_eq!(field_of("{"), "(json)");
+    }
+
+    #[test]
+    fn type_errors_name_the_element_and_the_angle_key() {
+        assert_eq!(
+            field_of(r#"{"velocity_m_s": [80, "x"]}"#),
+            "velocity_m_s[1]"
+        );
+        assert_eq!(
+            field_of(r#"{"grain": {"diameter_m": [2e-4, true]}}"#),
+            "grain.diameter_m[1]"
+        );
+        assert_eq!(
+            field_of(r#"{"impacts": {"fifteen": 30}}"#),
+            "impacts[\"fifteen\"]"
+        );
+        assert_eq!(field_of(r#"{"impacts": {"15": -3}}"#), "impacts[\"15\"]");
+        assert_eq!(
+            field_of(r#"{"impacts": {"15": 30, "15.0": 40}}"#),
+            "impacts[\"15.0\"]"
+        );
+        assert_eq!(field_of(r#"{"samples": 2.5}"#), "samples");
+        assert_eq!(
+            field_of(r#"{"shapes": [{"name": "x", "vertices": 1}]}"#),
+            "shapes[0].vertices"
+        );
+        // A top-level null is the default, as if the field were left out.
+        assert_eq!(parse(r#"{"seed": null}"#).unwrap(), CampaignSpec::default());
+    }
+
+    #[test]
+    fn serialised_form_is_pinned() {
+        // Stored specs are compared byte for byte (idempotent resubmission).
+        let s = parse(r#"{"velocity_m_s": [80, 100], "angles_deg": 45, "impacts": {"45": 30}}"#)
+            .unwrap();
+        assert_eq!(
+            serde_json::to_string(&s).unwrap(),
+            r#"{"name":null,"seed":0,"angles_deg":[45.0],"shapes":["octagon","hexagon","square","rectangle"],"samples":25,"impacts":{"45":30},"velocity_m_s":[80.0,100.0],"grain":{"diameter_m":0.00025,"density_kg_m3":2500.0},"spacing_m":8e-6,"distribution_range_dg":1.0,"material":"aisi304","friction":0.5,"surface_width_dg":4.0,"surface_depth_dg":1.5,"settle_fraction":0.02,"allow_short_samples":false}"#
+        );
     }
 
     #[test]

@@ -3,9 +3,9 @@
 //! surface has settled.
 
 use grit_sph::{
-    cfl_matched_stiffness, contact::ContactModel, particles::KINEMATIC, Absorber, ContactParams,
-    InputError, KernelKind, Material, Motion, Particles, Polygon, Settings, SimError, Timers,
-    Vector, World,
+    cfl_matched_stiffness, contact::ContactModel, neighbours, particles::KINEMATIC, Absorber,
+    ContactParams, InputError, KernelKind, Material, Motion, Particles, Polygon, Settings,
+    SimError, Timers, Vector, World,
 };
 use serde::{Deserialize, Serialize};
 
@@ -40,56 +40,109 @@ pub struct ImpactParams {
     /// The impact ends once the grain has left and the surface kinetic energy is below this
     /// fraction of the grain's initial kinetic energy.
     pub settle_fraction: f64,
-    /// Numerical choices; the defaults are the seed's (issue 5 sweeps them).
+    /// Numerical choices; the defaults are the seed's (the speed–accuracy sweep varies them).
     pub numerics: Numerics,
 }
 
-/// The numerical choices of an impact scene that issue 5's speed–accuracy and stability studies
+/// The numerical choices of an impact scene that the speed–accuracy and stability studies
 /// vary; the defaults are the seed's sections 2–3, plus savings that change no result.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+///
+/// In JSON it keeps one flat object of the choices a scene may set (`NumericsJson`): the
+/// engine's `kernel`, `cfl`, `hourglass`, `contact_limits_dt`, `cell_order`, and `grain_shell`
+/// for its `rigid_shell`, beside the impact's own. The engine's other settings are not part of
+/// a scene, so stored scenes and checkpoints read and write the same bytes as ever.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "NumericsJson", into = "NumericsJson")]
 pub struct Numerics {
-    /// Kernel (seed: the quintic spline of eq. 4).
-    pub kernel: KernelKind,
-    /// Courant number of the time step.
-    pub cfl: f64,
-    /// Hourglass coefficient α of eq. 16.
-    pub hourglass: f64,
+    /// Engine settings: kernel (seed: quintic spline, eq. 4), Courant number, hourglass α of
+    /// eq. 16, whether the contact springs may shorten the time step (off only in the stability
+    /// map), the grain as its outline particles only (`rigid_shell`: its mass and inertia come
+    /// from the polygon either way), and Z-order of the surface's particles (`cell_order`:
+    /// results differ by rounding only). Its `spacing_m` gives way to the scene's.
+    pub engine: Settings,
     /// Contact detection (seed: extrapolated distance and normal, eqs. 21–23).
     pub contact_model: ContactModel,
     /// Repulsion and friction spring stiffness (eqs. 24–25) over the CFL-matched default.
     pub contact_stiffness_scale: f64,
-    /// Whether the contact springs may shorten the time step (off only in the stability map).
-    pub contact_limits_dt: bool,
-    /// Simulate only the grain's outline particles, the layer that can touch the surface; its
-    /// mass and inertia come from the polygon either way (issue 5, "model no more").
-    pub grain_shell: bool,
     /// Move the grain along its straight, force-free path to just before its first contact
-    /// instead of simulating the flight step by step (issue 5, "model no more").
+    /// instead of simulating the flight step by step (docs/performance.md, "model no more").
     pub skip_flight: bool,
-    /// Keep the surface's particles in Z-order of neighbour cells (`Settings::cell_order`;
-    /// issue 5, "model no more"): results differ by rounding only.
-    pub cell_order: bool,
     /// Thickness, in particle layers, of an absorbing (sponge) layer just inside the surface's
-    /// fixed bottom and side bands; 0 for none (`grit_sph::Absorber`; issue 5, "model no more").
+    /// fixed bottom and side bands; 0 for none (`grit_sph::Absorber`).
     pub absorbing_layers: f64,
 }
 
 impl Default for Numerics {
     fn default() -> Self {
-        let s = Settings::default();
         Numerics {
-            kernel: s.kernel,
-            cfl: s.cfl,
-            hourglass: s.hourglass,
+            engine: Settings {
+                // Ours, not the seed's: bitwise the same results at less cost (tests/sample.rs).
+                rigid_shell: true,
+                ..Settings::default()
+            },
             contact_model: ContactModel::Extrapolated,
             contact_stiffness_scale: 1.0,
-            contact_limits_dt: s.contact_limits_dt,
-            // Ours, not the seed's: bitwise the same results at less cost (tests/sample.rs).
-            grain_shell: true,
             skip_flight: true,
-            cell_order: s.cell_order,
             absorbing_layers: 0.0,
+        }
+    }
+}
+
+/// The JSON form of `Numerics`: the keys scenes have always been written with.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct NumericsJson {
+    kernel: KernelKind,
+    cfl: f64,
+    hourglass: f64,
+    contact_model: ContactModel,
+    contact_stiffness_scale: f64,
+    contact_limits_dt: bool,
+    grain_shell: bool,
+    skip_flight: bool,
+    cell_order: bool,
+    absorbing_layers: f64,
+}
+
+impl Default for NumericsJson {
+    fn default() -> Self {
+        Numerics::default().into()
+    }
+}
+
+impl From<Numerics> for NumericsJson {
+    fn from(n: Numerics) -> Self {
+        NumericsJson {
+            kernel: n.engine.kernel,
+            cfl: n.engine.cfl,
+            hourglass: n.engine.hourglass,
+            contact_model: n.contact_model,
+            contact_stiffness_scale: n.contact_stiffness_scale,
+            contact_limits_dt: n.engine.contact_limits_dt,
+            grain_shell: n.engine.rigid_shell,
+            skip_flight: n.skip_flight,
+            cell_order: n.engine.cell_order,
+            absorbing_layers: n.absorbing_layers,
+        }
+    }
+}
+
+impl From<NumericsJson> for Numerics {
+    fn from(j: NumericsJson) -> Self {
+        Numerics {
+            engine: Settings {
+                kernel: j.kernel,
+                cfl: j.cfl,
+                hourglass: j.hourglass,
+                contact_limits_dt: j.contact_limits_dt,
+                rigid_shell: j.grain_shell,
+                cell_order: j.cell_order,
+                ..Settings::default()
+            },
+            contact_model: j.contact_model,
+            contact_stiffness_scale: j.contact_stiffness_scale,
+            skip_flight: j.skip_flight,
+            absorbing_layers: j.absorbing_layers,
         }
     }
 }
@@ -239,16 +292,9 @@ impl ImpactParams {
 
     /// Engine settings for this scene (seed sections 2–3 defaults at this spacing).
     pub fn settings(&self) -> Settings {
-        let n = &self.numerics;
         Settings {
             spacing_m: self.spacing_m,
-            kernel: n.kernel,
-            cfl: n.cfl,
-            hourglass: n.hourglass,
-            contact_limits_dt: n.contact_limits_dt,
-            rigid_shell: n.grain_shell,
-            cell_order: n.cell_order,
-            ..Settings::default()
+            ..self.numerics.engine.clone()
         }
     }
 
@@ -392,7 +438,7 @@ pub enum ImpactError {
     /// The scene was not valid.
     #[error(transparent)]
     Input(#[from] InputError),
-    /// The simulation went unstable (DESIGN.md failure checks).
+    /// The simulation went unstable (the engine's failure checks, docs/design.md).
     #[error(transparent)]
     Sim(#[from] SimError),
     /// Cancelled from outside; the surface state is untouched.
@@ -484,7 +530,7 @@ pub fn impact_world(
 
 /// The reference impact (seed section 4: hexagon, 45°, 100 m/s, AISI 304) at `spacing_m` on a
 /// fresh surface, stepped until the grain has pressed on it for `contact_steps` steps: the state
-/// the stage benchmarks time (issue 5).
+/// the stage benchmarks time (docs/performance.md).
 pub fn mid_contact_world(spacing_m: f64, contact_steps: u32) -> Result<World, ImpactError> {
     let params = ImpactParams {
         spacing_m,
@@ -609,7 +655,7 @@ pub fn run_impact_observed(
 pub fn flight_to_contact(params: &ImpactParams, surface: &Particles, grain: &GrainStart) -> f64 {
     let dx = params.spacing_m;
     let settings = params.settings();
-    let kernel = grit_sph::Kernel::new(params.numerics.kernel, settings.h_over_dx * dx);
+    let kernel = grit_sph::Kernel::new(settings.kernel, settings.h_over_dx * dx);
     let reach = kernel.radius();
     let (pts, boundary) = grain.polygon.fill_layered(dx);
     let outline: Vec<Vector> = pts
@@ -762,24 +808,17 @@ fn attached(world: &World, s: usize, link: f64) -> Vec<bool> {
         }
         i
     }
-    let inv = 1.0 / link;
-    let key = |x: Vector| ((x.x * inv).floor() as i64, (x.y * inv).floor() as i64);
-    let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
-    for i in (0..n).filter(|&i| p.body[i] as usize == s) {
-        cells.entry(key(p.pos[i])).or_default().push(i);
-    }
-    for i in (0..n).filter(|&i| p.body[i] as usize == s) {
-        let (cx, cy) = key(p.pos[i]);
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                for &j in cells.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| v) {
-                    if j > i && (p.pos[i] - p.pos[j]).norm() < link {
-                        let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                        if a != b {
-                            parent[a.max(b)] = a.min(b);
-                        }
-                    }
-                }
+    let ours: Vec<bool> = (0..n).map(|i| p.body[i] as usize == s).collect();
+    // The engine's cell grid, its radius a hair over `link` so that the strict test below,
+    // not rounding in a squared distance, decides every pair.
+    let near = neighbours::build(&p.pos, &ours, &ours, link * (1.0 + 1e-9), |i, j| {
+        (p.pos[i] - p.pos[j]).norm() < link
+    });
+    for i in 0..n {
+        for &j in near.of(i) {
+            let (a, b) = (root(&mut parent, i), root(&mut parent, j as usize));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
             }
         }
     }
@@ -805,4 +844,24 @@ pub fn free_particles(surface: &Particles) -> usize {
         .iter()
         .filter(|&&f| f & KINEMATIC == 0)
         .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numerics_keep_their_json_keys() {
+        // Scenes are stored (farm cells, checkpoints) and compared as this JSON.
+        let n = Numerics::default();
+        let json = serde_json::to_string(&n).unwrap();
+        assert_eq!(
+            json,
+            r#"{"kernel":"quintic","cfl":0.3,"hourglass":0.1,"contact_model":"extrapolated","contact_stiffness_scale":1.0,"contact_limits_dt":true,"grain_shell":true,"skip_flight":true,"cell_order":false,"absorbing_layers":0.0}"#
+        );
+        assert_eq!(serde_json::from_str::<Numerics>(&json).unwrap(), n);
+        let n: Numerics = serde_json::from_str(r#"{"cfl": 0.2, "grain_shell": false}"#).unwrap();
+        assert_eq!((n.engine.cfl, n.engine.rigid_shell), (0.2, false));
+        assert!(serde_json::from_str::<Numerics>(r#"{"h_over_dx": 1.5}"#).is_err());
+    }
 }

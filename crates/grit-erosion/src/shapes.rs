@@ -27,6 +27,7 @@
 
 use std::fmt;
 
+use grit_sph::{geometry, Vector};
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
@@ -151,8 +152,9 @@ impl Shape {
         }
     }
 
-    /// Checks a custom polygon (≥ 3 finite vertices, non-zero area, simple) and its name;
-    /// `field` is the shape's path, e.g. `shapes[2]`, and errors name `shapes[2].vertices_m`.
+    /// Checks a custom polygon (by `grit_sph::geometry::validate_polygon`: ≥ 3 finite vertices,
+    /// non-zero area, simple) and its name; `field` is the shape's path, e.g. `shapes[2]`, and
+    /// errors name `shapes[2].vertices_m`.
     pub fn validate(&self, field: &str) -> Result<(), ShapeError> {
         let Shape::Polygon { name, vertices_m } = self else {
             return Ok(());
@@ -167,7 +169,8 @@ impl Shape {
                 format!("`{name}` is a built-in shape; give a custom polygon another name"),
             ));
         }
-        validate_polygon(vertices_m, &format!("{field}.vertices_m"))
+        geometry::validate_polygon(vertices_m, &format!("{field}.vertices_m"))
+            .map_err(|e| invalid(&e.field, e.rule))
     }
 
     /// Unscaled outline in counter-clockwise order (before centring and scaling).
@@ -258,34 +261,20 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-/// Signed polygon area by the shoelace formula (positive when counter-clockwise).
+/// Signed area of an outline (positive when counter-clockwise), by the engine's shoelace
+/// formula (`grit_sph::geometry::signed_area`).
 pub fn signed_area(v: &[[f64; 2]]) -> f64 {
-    let n = v.len();
-    let mut s = 0.0;
-    for i in 0..n {
-        let (a, b) = (v[i], v[(i + 1) % n]);
-        s += a[0] * b[1] - b[0] * a[1];
-    }
-    0.5 * s
+    geometry::signed_area(&vectors(v))
 }
 
-/// Area centroid of a simple polygon (not the vertex mean, which uneven vertex spacing
-/// would bias).
+/// Area centroid of an outline, by the engine's formula (`grit_sph::geometry::centroid`).
 pub fn centroid(v: &[[f64; 2]]) -> [f64; 2] {
-    let n = v.len();
-    // Shifting to the first vertex first keeps the sums well conditioned for outlines far
-    // from the origin.
-    let o = v[0];
-    let (mut a2, mut cx, mut cy) = (0.0, 0.0, 0.0);
-    for i in 0..n {
-        let p = [v[i][0] - o[0], v[i][1] - o[1]];
-        let q = [v[(i + 1) % n][0] - o[0], v[(i + 1) % n][1] - o[1]];
-        let c = p[0] * q[1] - q[0] * p[1];
-        a2 += c;
-        cx += (p[0] + q[0]) * c;
-        cy += (p[1] + q[1]) * c;
-    }
-    [o[0] + cx / (3.0 * a2), o[1] + cy / (3.0 * a2)]
+    let c = geometry::centroid(&vectors(v));
+    [c.x, c.y]
+}
+
+fn vectors(v: &[[f64; 2]]) -> Vec<Vector> {
+    v.iter().map(|p| Vector::new(p[0], p[1])).collect()
 }
 
 /// Indices of the convex hull's vertices, counter-clockwise, collinear points dropped
@@ -374,91 +363,6 @@ pub fn angularity(v: &[[f64; 2]]) -> f64 {
         sum += (2.0 * PI / beta).sqrt() * hull_exterior / (2.0 * PI);
     }
     sum * sum
-}
-
-/// Checks that `v` is a simple polygon: ≥ 3 finite vertices, no repeated vertex, non-zero
-/// area, no edge crossing or touching another; errors name `field`.
-pub fn validate_polygon(v: &[[f64; 2]], field: &str) -> Result<(), ShapeError> {
-    let n = v.len();
-    if n < 3 {
-        return Err(invalid(
-            field,
-            format!("needs at least 3 vertices, got {n}"),
-        ));
-    }
-    if let Some(i) = v
-        .iter()
-        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
-    {
-        return Err(invalid(field, format!("vertex {i} is not finite")));
-    }
-    for i in 0..n {
-        if v[i] == v[(i + 1) % n] {
-            return Err(invalid(
-                field,
-                format!("vertices {i} and {} coincide", (i + 1) % n),
-            ));
-        }
-    }
-    let (mut lo, mut hi) = (v[0], v[0]);
-    for p in v {
-        lo = [lo[0].min(p[0]), lo[1].min(p[1])];
-        hi = [hi[0].max(p[0]), hi[1].max(p[1])];
-    }
-    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    // Relative to the bounding box, so the test does not depend on the unit of length.
-    if signed_area(v).abs() <= 1e-12 * extent * extent {
-        return Err(invalid(field, "area is zero: the vertices are collinear"));
-    }
-    for i in 0..n {
-        let (a, b, c) = (v[i], v[(i + 1) % n], v[(i + 2) % n]);
-        let fold = (b[0] - a[0]) * (c[0] - b[0]) + (b[1] - a[1]) * (c[1] - b[1]);
-        if cross(a, b, c) == 0.0 && fold < 0.0 {
-            return Err(invalid(
-                field,
-                format!(
-                    "edges {i} and {} fold back on each other at vertex {}: the polygon must be simple",
-                    (i + 1) % n,
-                    (i + 1) % n
-                ),
-            ));
-        }
-    }
-    for i in 0..n {
-        for j in i + 2..n {
-            if i == 0 && j == n - 1 {
-                continue; // adjacent through vertex 0
-            }
-            if segments_touch(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]) {
-                return Err(invalid(
-                    field,
-                    format!("edges {i} and {j} intersect: the polygon must be simple"),
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Whether closed segments pq and rs share any point.
-fn segments_touch(p: [f64; 2], q: [f64; 2], r: [f64; 2], s: [f64; 2]) -> bool {
-    let on = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
-        c[0] >= a[0].min(b[0])
-            && c[0] <= a[0].max(b[0])
-            && c[1] >= a[1].min(b[1])
-            && c[1] <= a[1].max(b[1])
-    };
-    let (d1, d2) = (cross(r, s, p), cross(r, s, q));
-    let (d3, d4) = (cross(p, q, r), cross(p, q, s));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    (d1 == 0.0 && on(r, s, p))
-        || (d2 == 0.0 && on(r, s, q))
-        || (d3 == 0.0 && on(p, q, r))
-        || (d4 == 0.0 && on(p, q, s))
 }
 
 /// Serde form of `Shape`: a built-in's name, or `{name, vertices_m}`.

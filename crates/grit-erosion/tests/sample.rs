@@ -213,7 +213,7 @@ fn grain_shell_gives_the_full_grain_bit_for_bit() {
     for angle in [45.0, 90.0] {
         let run = |shell: bool| {
             let mut params = coarse(angle);
-            params.numerics.grain_shell = shell;
+            params.numerics.engine.rigid_shell = shell;
             let mut s = Sample::new(params, 5).unwrap();
             for _ in 0..3 {
                 s.run_next().unwrap();

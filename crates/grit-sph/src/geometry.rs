@@ -14,59 +14,12 @@ pub struct Polygon {
 }
 
 impl Polygon {
-    /// Validates and builds a polygon; `field` names the input for errors.
-    ///
-    /// Rejects fewer than 3 vertices, non-finite coordinates, zero area and self-intersection;
-    /// clockwise input is reversed so every polygon is counter-clockwise.
+    /// Validates (`validate_polygon`) and builds a polygon; `field` names the input for
+    /// errors. Clockwise input is reversed so every polygon is counter-clockwise.
     pub fn new(vertices: &[[f64; 2]], field: &str) -> Result<Self, InputError> {
-        if vertices.len() < 3 {
-            return Err(InputError::new(
-                field,
-                format!(
-                    "a polygon needs at least 3 vertices, got {}",
-                    vertices.len()
-                ),
-            ));
-        }
-        if let Some(k) = vertices
-            .iter()
-            .position(|v| !(v[0].is_finite() && v[1].is_finite()))
-        {
-            return Err(InputError::new(
-                format!("{field}[{k}]"),
-                "vertex coordinates must be finite",
-            ));
-        }
-        let mut v: Vec<Vector> = vertices.iter().map(|p| Vector::new(p[0], p[1])).collect();
-        let n = v.len();
-        for i in 0..n {
-            if (v[i] - v[(i + 1) % n]).norm() == 0.0 {
-                return Err(InputError::new(
-                    format!("{field}[{}]", (i + 1) % n),
-                    "repeats the vertex before it",
-                ));
-            }
-        }
-        // Any two non-adjacent edges that touch make the polygon non-simple.
-        for i in 0..n {
-            for j in i + 1..n {
-                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
-                if adjacent {
-                    continue;
-                }
-                if segments_intersect(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]) {
-                    return Err(InputError::new(
-                        field,
-                        format!("polygon is self-intersecting: edge {i} crosses edge {j}"),
-                    ));
-                }
-            }
-        }
-        let a = signed_area(&v);
-        if a.abs() <= f64::EPSILON * bbox_diag2(&v) {
-            return Err(InputError::new(field, "polygon has zero area"));
-        }
-        if a < 0.0 {
+        validate_polygon(vertices, field)?;
+        let mut v = vectors(vertices);
+        if signed_area(&v) < 0.0 {
             v.reverse();
         }
         Ok(Polygon { vertices: v })
@@ -105,16 +58,10 @@ impl Polygon {
         signed_area(&self.vertices)
     }
 
-    /// Centroid (m).
+    /// Area centroid (m). Summed about the coordinate origin, unlike `centroid`: rigid bodies
+    /// are placed by it, and another reference point would move them by rounding.
     pub fn centroid(&self) -> Vector {
-        let v = &self.vertices;
-        let n = v.len();
-        let mut c = Vector::zeros();
-        for i in 0..n {
-            let (a, b) = (v[i], v[(i + 1) % n]);
-            c += (a + b) * cross(a, b);
-        }
-        c / (6.0 * self.area())
+        centroid_about(&self.vertices, Vector::zeros())
     }
 
     /// Polar second moment of area about the centroid (m⁴); times density gives the inertia.
@@ -245,29 +192,106 @@ impl Polygon {
 
     /// Bounding box (min, max).
     pub fn bbox(&self) -> (Vector, Vector) {
-        let mut lo = Vector::new(f64::INFINITY, f64::INFINITY);
-        let mut hi = -lo;
-        for p in &self.vertices {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        (lo, hi)
+        bbox(&self.vertices)
     }
 }
 
-fn signed_area(v: &[Vector]) -> f64 {
+/// Signed polygon area by the shoelace formula (positive when counter-clockwise).
+pub fn signed_area(v: &[Vector]) -> f64 {
     let n = v.len();
     (0..n).map(|i| cross(v[i], v[(i + 1) % n])).sum::<f64>() * 0.5
 }
 
-fn bbox_diag2(v: &[Vector]) -> f64 {
+/// Area centroid of a simple polygon (not the vertex mean, which uneven vertex spacing would
+/// bias), summed about the first vertex so outlines far from the origin stay well conditioned.
+pub fn centroid(v: &[Vector]) -> Vector {
+    centroid_about(v, v[0])
+}
+
+fn centroid_about(v: &[Vector], o: Vector) -> Vector {
+    let n = v.len();
+    let (mut a2, mut c) = (0.0, Vector::zeros());
+    for i in 0..n {
+        let (p, q) = (v[i] - o, v[(i + 1) % n] - o);
+        let k = cross(p, q);
+        a2 += k;
+        c += (p + q) * k;
+    }
+    o + c / (3.0 * a2)
+}
+
+/// Below this fraction of its bounding box's larger side squared, a polygon's area counts as
+/// zero: rounding in collinear vertices leaves an area of that order, which does not depend
+/// on the unit of length.
+pub const ZERO_AREA_TOLERANCE: f64 = 1e-12;
+
+/// Checks that `v` is a simple polygon: at least 3 finite vertices, no vertex repeating the
+/// one before it, an area above `ZERO_AREA_TOLERANCE`, no two edges folding back on each other
+/// or crossing or touching. Errors name `field` and the rule broken.
+pub fn validate_polygon(v: &[[f64; 2]], field: &str) -> Result<(), InputError> {
+    let invalid = |rule: String| Err(InputError::new(field, rule));
+    let n = v.len();
+    if n < 3 {
+        return invalid(format!("a polygon needs at least 3 vertices, got {n}"));
+    }
+    if let Some(i) = v
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return invalid(format!("vertex {i} is not finite"));
+    }
+    let v = vectors(v);
+    for i in 0..n {
+        if v[i] == v[(i + 1) % n] {
+            return invalid(format!("vertices {i} and {} coincide", (i + 1) % n));
+        }
+    }
+    // Two non-adjacent edges that touch; a zero area with such a pair is a crossing (a bow
+    // tie), one without is collinear vertices.
+    let crossing = (0..n)
+        .flat_map(|i| (i + 2..n).map(move |j| (i, j)))
+        .filter(|&(i, j)| !(i == 0 && j == n - 1))
+        .find(|&(i, j)| segments_intersect(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]));
+    let crossed = |(i, j): (usize, usize)| {
+        invalid(format!(
+            "polygon is self-intersecting: edges {i} and {j} intersect; it must be simple"
+        ))
+    };
+    let (lo, hi) = bbox(&v);
+    let extent = (hi - lo).max();
+    if signed_area(&v).abs() <= ZERO_AREA_TOLERANCE * extent * extent {
+        return match crossing {
+            Some(pair) => crossed(pair),
+            None => invalid("area is zero: the vertices are collinear".into()),
+        };
+    }
+    for i in 0..n {
+        let (a, b, c) = (v[i], v[(i + 1) % n], v[(i + 2) % n]);
+        if orient(a, b, c) == 0.0 && (b - a).dot(&(c - b)) < 0.0 {
+            let j = (i + 1) % n;
+            return invalid(format!(
+                "edges {i} and {j} fold back on each other at vertex {j}: the polygon must be simple"
+            ));
+        }
+    }
+    if let Some(pair) = crossing {
+        return crossed(pair);
+    }
+    Ok(())
+}
+
+fn vectors(v: &[[f64; 2]]) -> Vec<Vector> {
+    v.iter().map(|p| Vector::new(p[0], p[1])).collect()
+}
+
+fn bbox(v: &[Vector]) -> (Vector, Vector) {
     let mut lo = Vector::new(f64::INFINITY, f64::INFINITY);
     let mut hi = -lo;
     for p in v {
         lo = lo.inf(p);
         hi = hi.sup(p);
     }
-    (hi - lo).norm_squared()
+    (lo, hi)
 }
 
 fn point_segment_distance(p: Vector, a: Vector, b: Vector) -> f64 {
@@ -280,6 +304,7 @@ fn orient(a: Vector, b: Vector, c: Vector) -> f64 {
     cross(b - a, c - a)
 }
 
+/// Whether the closed segments p1p2 and q1q2 share any point.
 fn segments_intersect(p1: Vector, p2: Vector, q1: Vector, q2: Vector) -> bool {
     let d1 = orient(q1, q2, p1);
     let d2 = orient(q1, q2, p2);

@@ -212,29 +212,23 @@ impl StabilityGrid {
         let mut v = Vec::new();
         for &hourglass in &self.hourglass {
             for &cfl in &self.cfl {
-                v.push((
-                    Panel::CflHourglass,
-                    Numerics {
-                        cfl,
-                        hourglass,
-                        ..base
-                    },
-                ));
+                let mut n = base.clone();
+                n.engine.cfl = cfl;
+                n.engine.hourglass = hourglass;
+                v.push((Panel::CflHourglass, n));
             }
         }
         for panel in [Panel::StiffnessStep, Panel::StiffnessStepPenetration] {
             for &contact_stiffness_scale in &self.stiffness_scale {
                 for &cfl in &self.cfl {
-                    v.push((
-                        panel,
-                        Numerics {
-                            cfl,
-                            contact_model: panel.contact_model(),
-                            contact_stiffness_scale,
-                            contact_limits_dt: false,
-                            ..base
-                        },
-                    ));
+                    let mut n = Numerics {
+                        contact_model: panel.contact_model(),
+                        contact_stiffness_scale,
+                        ..base.clone()
+                    };
+                    n.engine.cfl = cfl;
+                    n.engine.contact_limits_dt = false;
+                    v.push((panel, n));
                 }
             }
         }
@@ -303,7 +297,7 @@ pub fn run_point(
     budget_factor: f64,
 ) -> Result<StabilityPoint, SampleError> {
     let params = ImpactParams {
-        numerics,
+        numerics: numerics.clone(),
         ..from.params().clone()
     };
     params.validate()?;
@@ -338,10 +332,10 @@ pub fn run_point(
     let mut point = StabilityPoint {
         panel,
         contact_model: numerics.contact_model,
-        cfl: numerics.cfl,
-        hourglass: numerics.hourglass,
+        cfl: numerics.engine.cfl,
+        hourglass: numerics.engine.hourglass,
         stiffness_scale: numerics.contact_stiffness_scale,
-        contact_limits_dt: numerics.contact_limits_dt,
+        contact_limits_dt: numerics.engine.contact_limits_dt,
         dt_s: first_dt.get(),
         steps: steps.get(),
         wall_s,
@@ -445,7 +439,7 @@ impl StabilityStudy {
                 panel,
                 numerics: &numerics,
             });
-            let point = run_point(&from, panel, numerics, self.budget_factor)?;
+            let point = run_point(&from, panel, numerics.clone(), self.budget_factor)?;
             progress(StabilityProgress::Done {
                 panel,
                 numerics: &numerics,
@@ -557,7 +551,8 @@ mod tests {
         assert!(pts
             .iter()
             .filter(|(p, _)| *p == Panel::StiffnessStepPenetration)
-            .all(|(_, n)| n.contact_model == ContactModel::Penetration && !n.contact_limits_dt));
+            .all(|(_, n)| n.contact_model == ContactModel::Penetration
+                && !n.engine.contact_limits_dt));
         let bad = StabilityGrid {
             cfl: vec![0.3, 2.5],
             ..g.clone()

@@ -74,23 +74,15 @@ impl Variant {
 
     /// The scene's numerics under this variant.
     pub fn numerics(&self) -> Numerics {
-        let base = Numerics::default();
+        let mut n = Numerics::default();
         match *self {
-            Variant::Seed => base,
-            Variant::WendlandC2 => Numerics {
-                kernel: KernelKind::WendlandC2,
-                ..base
-            },
-            Variant::Cfl(cfl) => Numerics { cfl, ..base },
-            Variant::FullFlight => Numerics {
-                skip_flight: false,
-                ..base
-            },
-            Variant::Absorbing(absorbing_layers) => Numerics {
-                absorbing_layers,
-                ..base
-            },
+            Variant::Seed => {}
+            Variant::WendlandC2 => n.engine.kernel = KernelKind::WendlandC2,
+            Variant::Cfl(cfl) => n.engine.cfl = cfl,
+            Variant::FullFlight => n.skip_flight = false,
+            Variant::Absorbing(layers) => n.absorbing_layers = layers,
         }
+        n
     }
 }
 
@@ -210,8 +202,8 @@ pub fn run_resolution(
     let hertz = hertz::simulate_with(
         hertz_per_radius,
         Settings {
-            kernel: n.kernel,
-            cfl: n.cfl,
+            kernel: n.engine.kernel,
+            cfl: n.engine.cfl,
             shepard_interval: hertz::DENSITY_FILTER,
             ..Settings::default()
         },
