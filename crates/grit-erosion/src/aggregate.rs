@@ -276,16 +276,33 @@ pub fn least_squares_slope(x: &[f64], y: &[f64]) -> Option<f64> {
     if n < 2 {
         return None;
     }
-    let xm = x.iter().sum::<f64>() / n as f64;
-    let ym = y.iter().sum::<f64>() / n as f64;
-    // Centred sums: cumulative masses are large offsets with small increments, and the
-    // uncentred formula would cancel catastrophically.
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (xi, yi) in x.iter().zip(y) {
-        sxy += (xi - xm) * (yi - ym);
-        sxx += (xi - xm) * (xi - xm);
+    let c = CentredSums::of(x, y);
+    (c.sxx > 0.0).then(|| c.sxy / c.sxx)
+}
+
+/// The sums of a least-squares line about the means: x̄, Σ(x − x̄)(y − ȳ) and Σ(x − x̄)².
+pub(crate) struct CentredSums {
+    pub xm: f64,
+    pub sxy: f64,
+    pub sxx: f64,
+}
+
+impl CentredSums {
+    /// Over the first min(len) points of x and y (at least one).
+    pub(crate) fn of(x: &[f64], y: &[f64]) -> CentredSums {
+        let n = x.len().min(y.len());
+        let (x, y) = (&x[..n], &y[..n]);
+        let xm = x.iter().sum::<f64>() / n as f64;
+        let ym = y.iter().sum::<f64>() / n as f64;
+        // Centred sums: cumulative masses are large offsets with small increments, and the
+        // uncentred formula would cancel catastrophically.
+        let (mut sxy, mut sxx) = (0.0, 0.0);
+        for (xi, yi) in x.iter().zip(y) {
+            sxy += (xi - xm) * (yi - ym);
+            sxx += (xi - xm) * (xi - xm);
+        }
+        CentredSums { xm, sxy, sxx }
     }
-    (sxx > 0.0).then(|| sxy / sxx)
 }
 
 /// A sample's erosion: slope of its series over the last `window` points (Fig. 8);

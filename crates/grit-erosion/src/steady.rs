@@ -19,7 +19,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::aggregate::{MeanPoint, SeriesPoint, SLOPE_WINDOW};
+use crate::aggregate::{CentredSums, MeanPoint, SeriesPoint, SLOPE_WINDOW};
 
 /// Impacts in each of the two slopes compared: the last and the previous half of the
 /// paper's last-20 window (section 4).
@@ -89,13 +89,7 @@ pub fn slope_fit(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
         return None;
     }
     let (x, y) = (&x[..n], &y[..n]);
-    let xm = x.iter().sum::<f64>() / n as f64;
-    let ym = y.iter().sum::<f64>() / n as f64;
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (xi, yi) in x.iter().zip(y) {
-        sxy += (xi - xm) * (yi - ym);
-        sxx += (xi - xm) * (xi - xm);
-    }
+    let CentredSums { xm, sxy, sxx } = CentredSums::of(x, y);
     if sxx <= 0.0 {
         return None;
     }
