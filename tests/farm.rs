@@ -149,10 +149,16 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     // The results say how they were made and whether they are steady-state rates: two
     // impacts per sample are far too few for the last-20 window.
     assert_eq!(farm["spec"]["samples"], 2, "{farm}");
-    assert!(farm["spec"]["friction"].is_number(), "defaults filled in: {farm}");
+    assert!(
+        farm["spec"]["friction"].is_number(),
+        "defaults filled in: {farm}"
+    );
     assert_eq!(farm["grit_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(farm["steady"], Value::Bool(false));
-    assert_eq!(farm["cells"][0]["steady_state"]["steady"], Value::Bool(false));
+    assert_eq!(
+        farm["cells"][0]["steady_state"]["steady"],
+        Value::Bool(false)
+    );
     let id_text = id.to_string();
     let out = grit_cli(&coord.url, &["results", &id_text]);
     assert!(out.status.success());

@@ -275,15 +275,34 @@ fn unsteady_cells_are_drawn_hollow_with_a_note() {
         ("modified_oka", 6),
     ] {
         let svg = std::fs::read_to_string(dir.path().join(format!("{chart}.svg"))).unwrap();
-        assert_eq!(circles(&svg, 5, hexagon, true), 1, "{chart}: one hollow cell");
-        assert_eq!(circles(&svg, 5, hexagon, false), filled, "{chart}: the others filled");
-        assert!(svg.contains("hollow: not at steady state"), "{chart}: legend");
-        assert!(svg.contains("Hollow markers: 1 of 18 cells"), "{chart}: note");
+        assert_eq!(
+            circles(&svg, 5, hexagon, true),
+            1,
+            "{chart}: one hollow cell"
+        );
+        assert_eq!(
+            circles(&svg, 5, hexagon, false),
+            filled,
+            "{chart}: the others filled"
+        );
+        assert!(
+            svg.contains("hollow: not at steady state"),
+            "{chart}: legend"
+        );
+        assert!(
+            svg.contains("Hollow markers: 1 of 18 cells"),
+            "{chart}: note"
+        );
     }
     // Convergence: the cell's running mean at 1, 2, 3 samples, all hollow.
     let svg = std::fs::read_to_string(dir.path().join("convergence.svg")).unwrap();
     assert!(svg.contains("Hollow markers: 1 of 18 cells"));
-    assert!(svg.split("<circle").filter(|c| c.contains("fill=\"none\"")).count() >= 3);
+    assert!(
+        svg.split("<circle")
+            .filter(|c| c.contains("fill=\"none\""))
+            .count()
+            >= 3
+    );
     // The cell's own chart: window marks (and their legend key) hollow, the reason under it.
     let svg = std::fs::read_to_string(dir.path().join("mass_loss_c08_45deg_hexagon.svg")).unwrap();
     assert_eq!(circles(&svg, 3, "#000000", true), 21);

@@ -191,7 +191,9 @@ impl Analysis {
             Err(e) => notes.push(format!("no modified-Oka chart: {e}")),
         }
         let steady_notes = crate::draw::steady_notes(
-            series.iter().flat_map(|s| s.points.iter().map(|p| p.steady)),
+            series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.steady)),
         );
         Analysis {
             series,

@@ -345,8 +345,9 @@ pub fn mass_loss(
                     });
                 }
             }
-            None => notes
-                .push("Steady state not checked (results written before the check).".into()),
+            None => {
+                notes.push("Steady state not checked (results written before the check).".into())
+            }
         }
         let fig = MassLoss {
             cell: c,
@@ -637,7 +638,13 @@ impl Figure for Normalised<'_> {
         let scaled = |i: usize, e45: f64| {
             self.an.series[i].points.iter().map(move |p| {
                 let d = p.std.unwrap_or(0.0);
-                (p.angle_deg, p.mean / e45, d / e45, p.std.is_some(), p.steady)
+                (
+                    p.angle_deg,
+                    p.mean / e45,
+                    d / e45,
+                    p.std.is_some(),
+                    p.steady,
+                )
             })
         };
         let values = || {
@@ -687,7 +694,10 @@ impl Figure for Normalised<'_> {
                         + Circle::new((11, 0), 4, c.filled())
                 });
         }
-        let drawn = self.shown.iter().flat_map(|&(i, _)| &self.an.series[i].points);
+        let drawn = self
+            .shown
+            .iter()
+            .flat_map(|&(i, _)| &self.an.series[i].points);
         hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }

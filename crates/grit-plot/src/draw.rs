@@ -200,7 +200,10 @@ mod tests {
         let hollow = marker_style(c, Some(false));
         assert!(!hollow.filled && hollow.stroke_width == HOLLOW_STROKE);
         assert!(marker_style(c, Some(true)).filled);
-        assert!(marker_style(c, None).filled, "files before the check draw as before");
+        assert!(
+            marker_style(c, None).filled,
+            "files before the check draw as before"
+        );
     }
 
     #[test]

@@ -137,7 +137,10 @@ async fn results_carry_the_spec_as_run_the_version_and_the_steady_check() {
     // No impact yet: no cell is steady, and each says why.
     assert_eq!(r.steady, Some(false));
     let check = r.cells[0].steady_state.as_ref().unwrap();
-    assert!(!check.steady && check.reason.contains("no samples"), "{check:?}");
+    assert!(
+        !check.steady && check.reason.contains("no samples"),
+        "{check:?}"
+    );
     assert_eq!(r.unsteady_warnings().len(), r.cells.len());
     let json = serde_json::to_value(s.results(id, false).await.unwrap()).unwrap();
     for key in ["spec", "grit_version", "steady"] {
