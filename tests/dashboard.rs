@@ -2,9 +2,9 @@
 //! token and holding no data; `GET /api/v1/workers` and `GET /api/v1/campaigns/{id}/jobs`
 //! show the workers seen recently and the failed jobs with their errors; headless Chromium,
 //! given the submit token in the URL fragment, renders a campaign a real worker finished, its
-//! progress and its erosion chart from the live API. The real `grit` binary over loopback, a
-//! fresh SQLite file per test, real (coarse) SPH impacts. TEST_LOG=1 prints the processes'
-//! logs.
+//! progress and its erosion chart from the live API, with unsteady cells hollow and the
+//! reasons noted. The real `grit` binary over loopback, a fresh SQLite file per test, real
+//! (coarse) SPH impacts. TEST_LOG=1 prints the processes' logs.
 
 use std::path::Path;
 use std::process::Command;
@@ -340,6 +340,33 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
         .unwrap_or_else(|| fail("the erosion chart"));
     if chart.matches("class=\"point\"").count() != 2 || !chart.contains("class=\"errbar\"") {
         fail("two erosion points with error bars");
+    }
+    // Twenty impacts leave the last-20 window starting at the first impact, before any
+    // sample's incubation ends: such a cell is hollow, and the note under the chart says why.
+    let unsteady: Vec<&serde_json::Value> = results["cells"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["steady_state"]["steady"] == json!(false))
+        .collect();
+    assert!(!unsteady.is_empty(), "20 impacts are not steady: {results}");
+    if chart.matches("data-steady=\"false\"").count() != unsteady.len() {
+        fail("one hollow point per unsteady cell");
+    }
+    let note = dom
+        .split("id=\"steady-note\"")
+        .nth(1)
+        .and_then(|rest| rest.split("</div>").next())
+        .unwrap_or_else(|| fail("the steady-state note"));
+    for c in &unsteady {
+        let reason = c["steady_state"]["reason"].as_str().unwrap();
+        let shown = reason
+            .replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;");
+        if !note.contains("Hollow points: not at steady state") || !note.contains(&shown) {
+            fail(&format!("the note with the reason `{reason}`"));
+        }
     }
     if !dom.contains("dash-worker") {
         fail("the worker");

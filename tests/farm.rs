@@ -146,6 +146,33 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     assert_eq!(farm["partial"], Value::Bool(false));
     let local = grit_run(dir.path(), &spec, "local", false);
     assert_eq!(farm, local, "farm results equal grit run results");
+    // The results say how they were made and whether they are steady-state rates: two
+    // impacts per sample are far too few for the last-20 window.
+    assert_eq!(farm["spec"]["samples"], 2, "{farm}");
+    assert!(
+        farm["spec"]["friction"].is_number(),
+        "defaults filled in: {farm}"
+    );
+    assert_eq!(farm["grit_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(farm["steady"], Value::Bool(false));
+    assert_eq!(
+        farm["cells"][0]["steady_state"]["steady"],
+        Value::Bool(false)
+    );
+    let id_text = id.to_string();
+    let out = grit_cli(&coord.url, &["results", &id_text]);
+    assert!(out.status.success());
+    let stdout: Value = serde_json::from_slice(&out.stdout).expect("stdout stays JSON");
+    assert_eq!(stdout, farm);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("warning: cell 60° hexagon is not at steady state: only 2 impacts"),
+        "{stderr}"
+    );
+    let out = grit_cli(&coord.url, &["status", &id_text]);
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("is not at steady state"), "{stderr}");
     // Both workers took part (one job each, claimed in parallel).
     assert!(_w1.log_text().contains("job complete") && _w2.log_text().contains("job complete"));
 }

@@ -239,6 +239,82 @@ fn plot_draws_raw_series_oka_fits_and_the_modified_model() {
     assert!(svg.contains("each sample (3)"), "raw series not drawn");
 }
 
+/// Circles of `r` pixels in `svg` drawn in `colour` (`#RRGGBB`), hollow or filled.
+fn circles(svg: &str, r: u32, colour: &str, hollow: bool) -> usize {
+    let paint = if hollow {
+        format!(r#"fill="none" stroke="{colour}""#)
+    } else {
+        format!(r#"fill="{colour}" stroke="none""#)
+    };
+    svg.split("<circle")
+        .skip(1)
+        .filter(|c| c.contains(&format!(r#"r="{r}""#)) && c.contains(&paint))
+        .count()
+}
+
+#[test]
+fn unsteady_cells_are_drawn_hollow_with_a_note() {
+    let mut v = synthetic_results();
+    // Every cell steady but the hexagon's at 45° (cell 8), whatever the noise made of them.
+    for (i, c) in v["cells"].as_array_mut().unwrap().iter_mut().enumerate() {
+        c["steady_state"]["steady"] = serde_json::Value::Bool(i != 8);
+    }
+    assert_eq!(v["cells"][8]["shape"], "hexagon");
+    assert_eq!(v["cells"][8]["angle_deg"], 45.0);
+    v["cells"][8]["steady_state"]["reason"] = "only 1 of 3 samples lost mass by impact 11".into();
+    v["steady"] = serde_json::Value::Bool(false);
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("results.json");
+    std::fs::write(&path, v.to_string()).unwrap();
+    let (dir, stdout) = plot(&path);
+    let hexagon = "#FF7F0E";
+    // The modified-Oka chart's legend key is a filled circle of the same size.
+    for (chart, filled) in [
+        ("erosion_vs_angle", 5),
+        ("erosion_normalised_45deg", 5),
+        ("modified_oka", 6),
+    ] {
+        let svg = std::fs::read_to_string(dir.path().join(format!("{chart}.svg"))).unwrap();
+        assert_eq!(
+            circles(&svg, 5, hexagon, true),
+            1,
+            "{chart}: one hollow cell"
+        );
+        assert_eq!(
+            circles(&svg, 5, hexagon, false),
+            filled,
+            "{chart}: the others filled"
+        );
+        assert!(
+            svg.contains("hollow: not at steady state"),
+            "{chart}: legend"
+        );
+        assert!(
+            svg.contains("Hollow markers: 1 of 18 cells"),
+            "{chart}: note"
+        );
+    }
+    // Convergence: the cell's running mean at 1, 2, 3 samples, all hollow.
+    let svg = std::fs::read_to_string(dir.path().join("convergence.svg")).unwrap();
+    assert!(svg.contains("Hollow markers: 1 of 18 cells"));
+    assert!(
+        svg.split("<circle")
+            .filter(|c| c.contains("fill=\"none\""))
+            .count()
+            >= 3
+    );
+    // The cell's own chart: window marks (and their legend key) hollow, the reason under it.
+    let svg = std::fs::read_to_string(dir.path().join("mass_loss_c08_45deg_hexagon.svg")).unwrap();
+    assert_eq!(circles(&svg, 3, "#000000", true), 21);
+    assert!(svg.contains("Not at steady state (docs/erosion.md): only 1 of 3 samples"));
+    let steady =
+        std::fs::read_to_string(dir.path().join("mass_loss_c07_30deg_hexagon.svg")).unwrap();
+    assert_eq!(circles(&steady, 3, "#000000", false), 21);
+    assert!(stdout.contains("(not at steady state)"), "{stdout}");
+    assert!(stdout.contains("Hollow markers: 1 of 18 cells"), "{stdout}");
+    check_images(dir.path());
+}
+
 #[test]
 fn plot_draws_the_committed_raw_results() {
     let (dir, stdout) = plot(&data("quick-raw-results.json"));

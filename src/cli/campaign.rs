@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use clap::Args;
 use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::CampaignResults;
 use grit_farm::api::{CampaignState, CampaignStatus};
 use grit_farm::embedded::{self, EmbeddedOptions, RunEvent};
 use grit_farm::worker::Stop;
@@ -205,6 +206,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
             fmt(c.erosion_std)
         );
     }
+    warn_unsteady(&outcome.results.results, true);
     // Charts beside results.json (`grit plot` draws the same); a chart that fails leaves
     // the results, already written, standing.
     match grit_plot::plot_file(&results_path, &a.out) {
@@ -219,6 +221,31 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         CampaignState::Done => ExitCode::SUCCESS,
         _ => ExitCode::from(1),
     })
+}
+
+/// Warns on stderr of every cell whose erosion is not a steady-state rate (docs/erosion.md,
+/// *Steady state*), so stdout and JSON output stay clean. Without `all`, only cells that
+/// have all their samples are judged: a running cell is not yet at steady state by design.
+fn warn_unsteady(results: &CampaignResults, all: bool) {
+    let mut judged = results.clone();
+    if !all {
+        judged.cells.retain(|c| !c.partial);
+    }
+    for line in judged.unsteady_warnings() {
+        eprintln!("{line}");
+    }
+}
+
+/// Warns of a campaign's unsteady cells from its results, if the coordinator sends them in
+/// a form this grit reads; a status must not fail because the results could not be judged.
+async fn warn_unsteady_remote(client: &Client, id: Uuid, finished: bool) {
+    match client.results_value(id, false).await {
+        Ok(v) => match serde_json::from_value::<CampaignResults>(v) {
+            Ok(r) => warn_unsteady(&r, finished),
+            Err(e) => eprintln!("steady state not checked: results not readable ({e})"),
+        },
+        Err(e) => eprintln!("steady state not checked: results not fetched ({e})"),
+    }
 }
 
 /// The bar's message while `grit run` runs: rate, ETA and jobs done.
@@ -325,6 +352,9 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             );
         }
     }
+    if s.impacts_done > 0 {
+        warn_unsteady_remote(&client, id, s.state.is_final()).await;
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -374,6 +404,9 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
                     e.error
                 );
             }
+            if s.impacts_done > 0 {
+                warn_unsteady_remote(client, id, true).await;
+            }
             return Ok(ExitCode::SUCCESS);
         }
         tokio::time::sleep(Duration::from_secs(2)).await;
@@ -390,6 +423,13 @@ pub async fn results(a: ResultsArgs) -> anyhow::Result<ExitCode> {
             eprintln!("results written to {}", p.display());
         }
         None => say!("{}", serde_json::to_string_pretty(&v)?),
+    }
+    // After the JSON, so a reader of the terminal sees the warnings last; the `raw` field,
+    // when present, is not part of `CampaignResults` and is ignored here. Results alone do
+    // not say whether the campaign still runs, so only complete cells are judged.
+    match serde_json::from_value::<CampaignResults>(v) {
+        Ok(r) => warn_unsteady(&r, false),
+        Err(e) => eprintln!("steady state not checked: results not readable ({e})"),
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -28,6 +28,8 @@ pub struct Point {
     pub mean: f64,
     /// Sample standard deviation, when 2 samples or more.
     pub std: Option<f64>,
+    /// Whether the cell is at steady state (section 4); `None` in files before the check.
+    pub steady: Option<bool>,
 }
 
 /// Oka's model for one series, or why not.
@@ -76,6 +78,8 @@ pub struct Analysis {
     pub modified: Result<Modified, String>,
     /// Fit parameters and skip reasons, in words.
     pub notes: Vec<String>,
+    /// How the angle charts draw cells not at steady state, when any are drawn.
+    pub steady_notes: Vec<String>,
 }
 
 /// Hardness of the surface the Oka curves use (the seed's AISI 304).
@@ -110,6 +114,7 @@ impl Analysis {
                 angle_deg: c.angle_deg,
                 mean,
                 std: c.erosion_std,
+                steady: c.steady_state.as_ref().map(|s| s.steady),
             };
             match series.iter_mut().find(|s| s.label == label) {
                 Some(s) => s.points.push(point),
@@ -185,10 +190,16 @@ impl Analysis {
             },
             Err(e) => notes.push(format!("no modified-Oka chart: {e}")),
         }
+        let steady_notes = crate::draw::steady_notes(
+            series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.steady)),
+        );
         Analysis {
             series,
             modified,
             notes,
+            steady_notes,
         }
     }
 }

@@ -14,7 +14,8 @@ use plotters::prelude::*;
 
 use crate::analysis::{series_label, Analysis, Series, HV_GPA};
 use crate::draw::{
-    colour, de, error_bar, file_safe, save, top, with_notes, DrawResult, Figure, FONT,
+    colour, de, error_bar, file_safe, marker_style, save, steady_notes, top, with_notes,
+    DrawResult, Figure, FONT,
 };
 use crate::{PlotError, PlotInput, RawSeries, Report};
 
@@ -129,6 +130,24 @@ fn dash_key(
     move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 22, y)], dash, gap, style)
 }
 
+/// A legend entry for the hollow markers of cells not at steady state, when any is drawn.
+fn hollow_key<DB: DrawingBackend>(chart: &mut Axes<'_, DB>, any: bool) -> DrawResult {
+    if any {
+        let style = marker_style(RGBColor(90, 90, 90), Some(false));
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(de)?
+            .label("hollow: not at steady state (docs/erosion.md)")
+            .legend(move |(x, y)| Circle::new((x + 11, y), 5, style));
+    }
+    Ok(())
+}
+
+/// Whether any of `steady` is a cell that failed the steady-state check.
+fn any_unsteady(mut steady: impl Iterator<Item = Option<bool>>) -> bool {
+    steady.any(|s| s == Some(false))
+}
+
 /// A sample's cumulative (grain g/m, loss mg/m), in impact order.
 fn sample_curve(r: &RawSeries) -> Vec<(f64, f64)> {
     let mut impacts = r.impacts.clone();
@@ -220,11 +239,20 @@ impl Figure for MassLoss<'_> {
             .legend(line_key(bold));
         if mean.len() >= self.window && self.window >= 2 {
             let tail = &mean[mean.len() - self.window..];
-            let marks = BLACK.filled();
+            let steady = c.steady_state.as_ref().map(|s| s.steady);
+            let marks = marker_style(BLACK, steady);
             chart
                 .draw_series(tail.iter().map(|p| Circle::new((p.0, p.1), 3, marks)))
                 .map_err(de)?
-                .label(format!("last {} points (erosion window)", self.window))
+                .label(format!(
+                    "last {} points (erosion window){}",
+                    self.window,
+                    if steady == Some(false) {
+                        ", hollow: not at steady state"
+                    } else {
+                        ""
+                    }
+                ))
                 .legend(move |(x, y)| Circle::new((x + 11, y), 3, marks));
             if let Some(e) = c.erosion_mean {
                 // The cell's erosion is the mean of the samples' slopes; drawn through the
@@ -301,6 +329,26 @@ pub fn mass_loss(
                 c.samples_reported, c.samples_planned
             ));
         }
+        // One line per condition: a reason can list three, too long for one line.
+        match &c.steady_state {
+            Some(s) => {
+                let head = if s.steady {
+                    "At steady state:"
+                } else {
+                    "Not at steady state (docs/erosion.md):"
+                };
+                for (k, part) in s.reason.split("; ").enumerate() {
+                    notes.push(if k == 0 {
+                        format!("{head} {part}")
+                    } else {
+                        format!("    {part}")
+                    });
+                }
+            }
+            None => {
+                notes.push("Steady state not checked (results written before the check).".into())
+            }
+        }
         let fig = MassLoss {
             cell: c,
             samples,
@@ -322,8 +370,8 @@ pub fn mass_loss(
 struct SampleAngles {
     label: String,
     sample: u32,
-    /// (angle, cumulative (grain g/m, loss mg/m)), by angle.
-    curves: Vec<(f64, Vec<(f64, f64)>)>,
+    /// (angle, cumulative (grain g/m, loss mg/m), the cell's steady state), by angle.
+    curves: Vec<(f64, Vec<(f64, f64)>, Option<bool>)>,
     window: usize,
     notes: Vec<String>,
 }
@@ -339,7 +387,7 @@ impl Figure for SampleAngles {
             self.label, self.sample
         );
         let mut chart = mass_axes(&area, caption, xmax, ymax)?;
-        for (i, (angle, pts)) in self.curves.iter().enumerate() {
+        for (i, (angle, pts, steady)) in self.curves.iter().enumerate() {
             let line = colour(i).stroke_width(2);
             chart
                 .draw_series(LineSeries::new(pts.iter().copied(), line))
@@ -347,16 +395,17 @@ impl Figure for SampleAngles {
                 .label(format!("{angle}°"))
                 .legend(line_key(line));
             if pts.len() >= self.window && self.window >= 2 {
-                let marks = colour(i).filled();
+                let marks = marker_style(colour(i), *steady);
                 chart
                     .draw_series(
                         pts[pts.len() - self.window..]
                             .iter()
-                            .map(|p| Circle::new(*p, 2, marks)),
+                            .map(|p| Circle::new(*p, 3, marks)),
                     )
                     .map_err(de)?;
             }
         }
+        hollow_key(&mut chart, any_unsteady(self.curves.iter().map(|c| c.2)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
     }
 }
@@ -397,24 +446,30 @@ pub fn sample_by_angle(
             raw.iter().filter(in_series).map(|r| r.sample).collect();
         let mut drawn = 0;
         for &k in numbers.iter().take(SAMPLES_BY_ANGLE) {
-            let mut curves: Vec<(f64, Vec<(f64, f64)>)> = raw
+            let mut curves: Vec<(f64, Vec<(f64, f64)>, Option<bool>)> = raw
                 .iter()
                 .filter(in_series)
                 .filter(|r| r.sample == k)
-                .map(|r| (cells[r.cell as usize].angle_deg, sample_curve(r)))
+                .map(|r| {
+                    let c = &cells[r.cell as usize];
+                    let steady = c.steady_state.as_ref().map(|s| s.steady);
+                    (c.angle_deg, sample_curve(r), steady)
+                })
                 .collect();
             if curves.len() < 2 {
                 continue;
             }
             curves.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut notes = vec![format!(
+                "Dots: the last {window} impacts, whose slope is the sample's erosion."
+            )];
+            notes.extend(steady_notes(curves.iter().map(|c| c.2)));
             let fig = SampleAngles {
                 label: label.clone(),
                 sample: k,
                 curves,
                 window,
-                notes: vec![format!(
-                    "Dots: the last {window} impacts, whose slope is the sample's erosion."
-                )],
+                notes,
             };
             let stem = format!("sample_by_angle_{}_s{k}", file_safe(&label));
             report.files.extend(save(&fig, out, &stem)?);
@@ -495,13 +550,19 @@ impl Figure for Angle<'_> {
             }
             let line = c.stroke_width(2);
             chart
-                .draw_series(
-                    LineSeries::new(
-                        s.points.iter().map(|p| (p.angle_deg, p.mean * MG_PER_G)),
-                        line,
+                .draw_series(s.points.iter().map(|p| {
+                    Circle::new(
+                        (p.angle_deg, p.mean * MG_PER_G),
+                        5,
+                        marker_style(c, p.steady),
                     )
-                    .point_size(5),
-                )
+                }))
+                .map_err(de)?;
+            chart
+                .draw_series(LineSeries::new(
+                    s.points.iter().map(|p| (p.angle_deg, p.mean * MG_PER_G)),
+                    line,
+                ))
                 .map_err(de)?
                 .label(format!("{}: simulated, bars ±1 std over samples", s.label))
                 .legend(move |(x, y)| {
@@ -524,6 +585,8 @@ impl Figure for Angle<'_> {
                     .legend(dash_key(line, 2, 3));
             }
         }
+        let drawn = self.an.series.iter().flat_map(|s| &s.points);
+        hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -548,6 +611,7 @@ pub fn erosion_vs_angle(
             .notes
             .iter()
             .filter(|n| !n.starts_with("modified Oka") && !n.starts_with("no modified"))
+            .chain(&an.steady_notes)
             .cloned()
             .collect(),
     };
@@ -574,7 +638,13 @@ impl Figure for Normalised<'_> {
         let scaled = |i: usize, e45: f64| {
             self.an.series[i].points.iter().map(move |p| {
                 let d = p.std.unwrap_or(0.0);
-                (p.angle_deg, p.mean / e45, d / e45, p.std.is_some())
+                (
+                    p.angle_deg,
+                    p.mean / e45,
+                    d / e45,
+                    p.std.is_some(),
+                    p.steady,
+                )
             })
         };
         let values = || {
@@ -598,7 +668,7 @@ impl Figure for Normalised<'_> {
             .legend(dash_key(grey, 7, 4));
         for &(i, e45) in &self.shown {
             let c = colour(i);
-            for (a, m, d, has) in scaled(i, e45) {
+            for (a, m, d, has, _) in scaled(i, e45) {
                 if has {
                     chart
                         .draw_series(error_bar(a, m - d, m + d, 1.2, c.stroke_width(1)))
@@ -608,8 +678,11 @@ impl Figure for Normalised<'_> {
             let line = c.stroke_width(2);
             chart
                 .draw_series(
-                    LineSeries::new(scaled(i, e45).map(|p| (p.0, p.1)), line).point_size(5),
+                    scaled(i, e45).map(|p| Circle::new((p.0, p.1), 5, marker_style(c, p.4))),
                 )
+                .map_err(de)?;
+            chart
+                .draw_series(LineSeries::new(scaled(i, e45).map(|p| (p.0, p.1)), line))
                 .map_err(de)?
                 .label(format!(
                     "{}: simulated, bars ±1 std / E(45°)",
@@ -621,6 +694,11 @@ impl Figure for Normalised<'_> {
                         + Circle::new((11, 0), 4, c.filled())
                 });
         }
+        let drawn = self
+            .shown
+            .iter()
+            .flat_map(|&(i, _)| &self.an.series[i].points);
+        hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -648,10 +726,16 @@ pub fn normalised(
         }
         return Ok(());
     }
+    let mut chart_notes = notes.clone();
+    chart_notes.extend(steady_notes(
+        shown
+            .iter()
+            .flat_map(|&(i, _)| an.series[i].points.iter().map(|p| p.steady)),
+    ));
     let fig = Normalised {
         an,
         shown,
-        notes: notes.clone(),
+        notes: chart_notes,
     };
     report
         .files
@@ -711,11 +795,13 @@ impl Figure for ModifiedChart<'_> {
                 }
             }
             chart
-                .draw_series(
-                    s.points
-                        .iter()
-                        .map(|p| Circle::new((p.angle_deg, p.mean * MG_PER_G), 5, c.filled())),
-                )
+                .draw_series(s.points.iter().map(|p| {
+                    Circle::new(
+                        (p.angle_deg, p.mean * MG_PER_G),
+                        5,
+                        marker_style(c, p.steady),
+                    )
+                }))
                 .map_err(de)?
                 .label(format!("{}: simulated, bars ±1 std", s.label))
                 .legend(move |(x, y)| Circle::new((x + 11, y), 5, c.filled()));
@@ -733,6 +819,8 @@ impl Figure for ModifiedChart<'_> {
                 .label(format!("{}: modified Oka, seed's n3..n6", s.label))
                 .legend(dash_key(line, 7, 4));
         }
+        let drawn = m.series.iter().flat_map(|&i| &self.an.series[i].points);
+        hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -746,12 +834,19 @@ pub fn modified_oka(
     if an.modified.is_err() {
         return Ok(());
     }
-    let notes = an
+    let mut notes: Vec<String> = an
         .notes
         .iter()
         .filter(|n| n.starts_with("modified Oka") || n.contains("Oka fit n1"))
         .cloned()
         .collect();
+    if let Ok(m) = &an.modified {
+        notes.extend(steady_notes(
+            m.series
+                .iter()
+                .flat_map(|&i| an.series[i].points.iter().map(|p| p.steady)),
+        ));
+    }
     let fig = ModifiedChart { an, notes };
     report.files.extend(save(&fig, out, "modified_oka")?);
     Ok(())
@@ -765,13 +860,14 @@ struct Convergence<'a> {
 
 impl Figure for Convergence<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
-        let area = with_notes(root, &[])?;
         let cells = || {
             self.results
                 .cells
                 .iter()
                 .filter(|c| !c.convergence.is_empty())
         };
+        let steady = |c: &CellResult| c.steady_state.as_ref().map(|s| s.steady);
+        let area = with_notes(root, &steady_notes(cells().map(steady)))?;
         let values = || {
             cells().flat_map(|c| {
                 c.convergence.iter().flat_map(|p| {
@@ -829,16 +925,17 @@ impl Figure for Convergence<'_> {
                 }
             }
             let line = col.stroke_width(2);
+            let points = || {
+                c.convergence
+                    .iter()
+                    .map(|p| (p.samples as f64, p.erosion_mean * MG_PER_G))
+            };
+            let marks = marker_style(col, steady(c));
             chart
-                .draw_series(
-                    LineSeries::new(
-                        c.convergence
-                            .iter()
-                            .map(|p| (p.samples as f64, p.erosion_mean * MG_PER_G)),
-                        line,
-                    )
-                    .point_size(4),
-                )
+                .draw_series(points().map(|p| Circle::new(p, 4, marks)))
+                .map_err(de)?;
+            chart
+                .draw_series(LineSeries::new(points(), line))
                 .map_err(de)?
                 .label(format!(
                     "{}: mean of the first k, bars ±1 std",
@@ -846,6 +943,7 @@ impl Figure for Convergence<'_> {
                 ))
                 .legend(line_key(line));
         }
+        hollow_key(&mut chart, any_unsteady(cells().map(steady)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }

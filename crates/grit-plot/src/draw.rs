@@ -147,3 +147,71 @@ pub fn file_safe(s: &str) -> String {
         })
         .collect()
 }
+
+/// Width of a hollow marker's outline, pixels.
+const HOLLOW_STROKE: u32 = 2;
+
+/// A cell's marker: hollow (outline only) when the cell is not at steady state, whose
+/// last-20 slope mixes in incubation (seed paper section 4; `docs/erosion.md`, *Steady
+/// state*); filled when it is, or when the file predates the check (`None`).
+pub fn marker_style(c: RGBColor, steady: Option<bool>) -> ShapeStyle {
+    if steady == Some(false) {
+        c.stroke_width(HOLLOW_STROKE)
+    } else {
+        c.filled()
+    }
+}
+
+/// The note under a chart of per-cell erosion saying how unsteady cells are drawn and which
+/// were never checked; empty when every cell drawn is steady.
+pub fn steady_notes(steady: impl Iterator<Item = Option<bool>>) -> Vec<String> {
+    let (mut total, mut unsteady, mut unchecked) = (0, 0, 0);
+    for s in steady {
+        total += 1;
+        match s {
+            Some(false) => unsteady += 1,
+            None => unchecked += 1,
+            Some(true) => {}
+        }
+    }
+    let mut notes = Vec::new();
+    if unsteady > 0 {
+        notes.push(format!(
+            "Hollow markers: {unsteady} of {total} cells not at steady state; their last-20 \
+             slope is no steady erosion rate (docs/erosion.md, Steady state)."
+        ));
+    }
+    if unchecked > 0 {
+        notes.push(format!(
+            "Steady state not checked for {unchecked} of {total} cells (results written \
+             before the check): drawn filled."
+        ));
+    }
+    notes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_unsteady_cells_are_hollow() {
+        let c = colour(1);
+        let hollow = marker_style(c, Some(false));
+        assert!(!hollow.filled && hollow.stroke_width == HOLLOW_STROKE);
+        assert!(marker_style(c, Some(true)).filled);
+        assert!(
+            marker_style(c, None).filled,
+            "files before the check draw as before"
+        );
+    }
+
+    #[test]
+    fn notes_count_unsteady_and_unchecked_cells() {
+        assert!(steady_notes([Some(true), Some(true)].into_iter()).is_empty());
+        let n = steady_notes([Some(true), Some(false), None].into_iter());
+        assert_eq!(n.len(), 2);
+        assert!(n[0].starts_with("Hollow markers: 1 of 3 cells not at steady state"));
+        assert!(n[1].starts_with("Steady state not checked for 1 of 3 cells"));
+    }
+}

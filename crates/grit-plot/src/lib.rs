@@ -82,6 +82,7 @@ pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
     charts::normalised(&analysis, out, &mut report)?;
     charts::modified_oka(&analysis, out, &mut report)?;
     charts::convergence(&input.results, out, &mut report)?;
+    report.notes.extend(analysis.steady_notes.iter().cloned());
     Ok(report)
 }
 
@@ -99,13 +100,17 @@ pub fn summary_table(results: &CampaignResults) -> String {
     );
     for c in &results.cells {
         s.push_str(&format!(
-            "{:>6.1}°  {:<24} {:>7}  {} ± {}{}\n",
+            "{:>6.1}°  {:<24} {:>7}  {} ± {}{}{}\n",
             c.angle_deg,
             analysis::series_label(&c.shape, &c.swept),
             c.samples,
             fmt(c.erosion_mean),
             fmt(c.erosion_std),
-            if c.partial { "  (partial)" } else { "" }
+            if c.partial { "  (partial)" } else { "" },
+            match &c.steady_state {
+                Some(s) if !s.steady => "  (not at steady state)",
+                _ => "",
+            }
         ));
     }
     s

@@ -288,7 +288,8 @@ impl Store {
     /// Aggregated results (partial while jobs remain); with `raw`, every sample's series.
     pub async fn results(&self, id: Uuid, raw: bool) -> Result<ResultsResponse> {
         let c = self.campaign_row(id).await?;
-        let spec = CampaignSpec::from_json(&c.get::<String, _>("spec"))?;
+        let spec_text: String = c.get("spec");
+        let spec = CampaignSpec::from_json(&spec_text)?;
         let cells = spec.cells()?;
         let rows = sqlx::query(
             "SELECT j.cell_index, j.sample_index, i.grain_mass_kg, i.mass_loss_kg
@@ -323,8 +324,13 @@ impl Store {
                 )
             })
             .collect();
+        // The stored spec is the parsed one written back, every default filled in, so a
+        // reader of the results can rerun exactly this campaign.
+        let spec_value: serde_json::Value = serde_json::from_str(&spec_text)
+            .map_err(|e| Error::Internal(format!("stored spec: {e}")))?;
         let results = aggregate_campaign(&inputs, grit_erosion::SLOPE_WINDOW)
-            .map_err(|e| Error::Internal(format!("aggregation: {e}")))?;
+            .map_err(|e| Error::Internal(format!("aggregation: {e}")))?
+            .with_spec(spec_value);
         let raw = if raw {
             Some(self.raw_series(id).await?)
         } else {

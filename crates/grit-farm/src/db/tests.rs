@@ -113,3 +113,37 @@ async fn failure_reports_keep_the_error_and_stale_leases_get_409() {
     assert!(s.claim("w").await.unwrap().is_none());
     assert_eq!(s.status(id).await.unwrap().state, CampaignState::Cancelled);
 }
+
+#[tokio::test]
+async fn results_carry_the_spec_as_run_the_version_and_the_steady_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let spec = CampaignSpec::from_json(TINY).unwrap();
+    let id = s.create_campaign(&spec, None).await.unwrap().id;
+    let r = s.results(id, false).await.unwrap().results;
+    // Defaults the submitted JSON left out are filled in, so the spec reruns as it ran.
+    let run = r.spec.as_ref().expect("spec");
+    assert_eq!(run["samples"], 2);
+    assert_eq!(run["seed"], 0);
+    assert_eq!(
+        CampaignSpec::from_json(&run.to_string()).unwrap(),
+        spec,
+        "the spec reads back as the one submitted"
+    );
+    for key in ["friction", "surface_width_dg", "grain", "material"] {
+        assert!(run.get(key).is_some(), "{key} filled in: {run}");
+    }
+    assert_eq!(r.grit_version.as_deref(), Some(env!("CARGO_PKG_VERSION")));
+    // No impact yet: no cell is steady, and each says why.
+    assert_eq!(r.steady, Some(false));
+    let check = r.cells[0].steady_state.as_ref().unwrap();
+    assert!(
+        !check.steady && check.reason.contains("no samples"),
+        "{check:?}"
+    );
+    assert_eq!(r.unsteady_warnings().len(), r.cells.len());
+    let json = serde_json::to_value(s.results(id, false).await.unwrap()).unwrap();
+    for key in ["spec", "grit_version", "steady"] {
+        assert!(json.get(key).is_some(), "{key} in {json}");
+    }
+}
