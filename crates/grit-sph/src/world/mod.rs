@@ -19,7 +19,7 @@ use crate::body::Body;
 use crate::contact::{ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::kernel::Kernel;
-use crate::math::{Matrix, Vector};
+use crate::math::Vector;
 use crate::neighbours::{self, NeighbourLists, PairCache};
 use crate::particles::Particles;
 use crate::stages::{self, Blowup, BodyConst, KernelSums, PassedThrough, SphView};
@@ -30,10 +30,8 @@ use crate::timers::{Stage, Timers};
 struct Scratch {
     /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
     pairs: PairCache,
-    /// Volumes, Shepard sums and correction matrices of the kernel sums.
+    /// Volumes, Shepard sums, correction matrices and velocity gradients of the kernel sums.
     sums: KernelSums,
-    /// Velocity gradients of the rates.
-    gradv: Vec<Matrix>,
     /// Accelerations of the forces.
     acc: Vec<Vector>,
     /// Contact force on each particle.
@@ -229,8 +227,8 @@ impl World {
         if self.needs_rebuild() {
             timers.time(Stage::Neighbours, || self.rebuild_neighbours());
         }
+        // The rates are summed in the kernel sums' pass; their timer stays at zero in a step.
         timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
-        timers.time(Stage::Rates, || self.rates(&bc));
         timers.time(Stage::Stress, || self.stress(&bc, dt));
         timers.time(Stage::Forces, || self.forces(&bc, dt));
         let contact = timers.time(Stage::Contact, || self.contact(&bc, dt));
@@ -262,12 +260,11 @@ impl World {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
             self.rebuild_neighbours();
             self.kernel_sums(&bc);
-            self.rates(&bc);
         }
         match stage {
             Stage::Neighbours => self.rebuild_neighbours(),
-            Stage::KernelSums => self.kernel_sums(&bc),
-            Stage::Rates => self.rates(&bc),
+            // The rates are summed in the kernel sums' pass.
+            Stage::KernelSums | Stage::Rates => self.kernel_sums(&bc),
             Stage::Stress => self.stress(&bc, dt),
             Stage::Forces => self.forces(&bc, dt),
             Stage::Contact => {
@@ -360,19 +357,13 @@ impl World {
         stages::kernel_sums(s, &mut self.scratch.pairs, &mut self.scratch.sums);
     }
 
-    fn rates(&mut self, bc: &[BodyConst]) {
-        let gradv =
-            stages::velocity_gradients(self.sph(bc), &self.scratch.pairs, &self.scratch.sums);
-        self.scratch.gradv = gradv;
-    }
-
     fn stress(&mut self, bc: &[BodyConst], dt: f64) {
         let beta = self.settings.taylor_quinney;
         let plastic_work = stages::stress(
             &mut self.particles,
             &self.bodies,
             bc,
-            &self.scratch.gradv,
+            &self.scratch.sums.gradv,
             beta,
             dt,
         );
@@ -391,7 +382,7 @@ impl World {
             s,
             &sc.pairs,
             &sc.sums.shepard,
-            &sc.gradv,
+            &sc.sums.gradv,
             &self.settings,
             dt,
             &mut sc.acc,
