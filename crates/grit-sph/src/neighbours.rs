@@ -253,13 +253,29 @@ pub(crate) fn body_pairs<'a>(
         })
 }
 
+/// A same-body pair inside the kernel support as the kernel sums leave it for the forces: the
+/// quotients dW/dr / r and x_ij / r are taken once here, so no later stage divides by r again
+/// (both are 0 for coincident particles, which every sum skips).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct CachedPair {
+    pub j: usize,
+    /// x_ij = x_i − x_j.
+    pub xij: Vector,
+    /// Unit vector x_ij / r.
+    pub e: Vector,
+    pub r: f64,
+    pub w: f64,
+    /// dW/dr / r: the kernel gradient is x_ij times this.
+    pub dw_r: f64,
+}
+
 /// Same-body pairs of this step with their kernel values, in each particle's slice of the
 /// neighbour rows (first `count[i]` entries used): computed once in the kernel sums, read by the
-/// rates and the forces, so each pair's kernel is evaluated once per step.
+/// forces, so each pair's kernel is evaluated once per step.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PairCache {
     /// Pairs, laid out like the neighbour rows.
-    pub pairs: Vec<Pair>,
+    pub pairs: Vec<CachedPair>,
     /// Pairs used in each particle's row.
     pub count: Vec<u32>,
 }
@@ -267,7 +283,7 @@ pub(crate) struct PairCache {
 impl PairCache {
     /// The cached same-body pairs of particle `i` (filled by the kernel sums this step).
     #[inline]
-    pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [Pair] {
+    pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [CachedPair] {
         let s = nl.start[i] as usize;
         &self.pairs[s..s + self.count[i] as usize]
     }

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::{ParTasks, SphView, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{Matrix, Vector};
-use crate::neighbours::{Pair, PairCache};
+use crate::neighbours::{CachedPair, PairCache};
 use crate::particles::KINEMATIC;
 use crate::world::Settings;
 
@@ -68,14 +68,21 @@ pub(crate) fn forces(
             let voli = p.mass[i] / p.rho[i];
             let mut a = Vector::zeros();
             let mut fhg = Vector::zeros();
-            for &Pair { j, xij, r, w, dw } in cache.of(nl, i) {
+            for &CachedPair {
+                j,
+                xij,
+                e,
+                r,
+                w,
+                dw_r,
+            } in cache.of(nl, i)
+            {
                 if r == 0.0 {
                     continue;
                 }
-                let grad = xij * (dw / r);
+                let grad = xij * dw_r;
                 a += (sig[i] + sig[j]) * grad * p.mass[j];
                 if alpha > 0.0 && w > 0.0 {
-                    let e = xij / r;
                     // Not the kernel sums' volume: the stress stage has moved ρ since (continuity), and
                     // both volumes must be the same step's for a symmetric pair force.
                     let volj = p.mass[j] / p.rho[j];

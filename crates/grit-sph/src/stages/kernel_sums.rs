@@ -5,8 +5,8 @@
 use rayon::prelude::*;
 
 use super::{ParTasks, SphView, MIN_SUPPORT_NEIGHBOURS};
-use crate::math::{outer, Matrix};
-use crate::neighbours::{body_pairs, Pair, PairCache};
+use crate::math::{outer, Matrix, Vector};
+use crate::neighbours::{body_pairs, CachedPair, PairCache};
 
 /// Per-particle results of the kernel sums, read by the later stages of the same step.
 #[derive(Debug, Clone, Default)]
@@ -51,10 +51,10 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
     let buf = &mut cache.pairs;
     // Rows are overwritten before they are read: grow, never clear (a memset per step).
     if buf.len() < nl.list.len() {
-        buf.resize(nl.list.len(), Pair::default());
+        buf.resize(nl.list.len(), CachedPair::default());
     }
     // One mutable slice per particle, so the rows fill in parallel, each by its own owner.
-    let mut rows: Vec<&mut [Pair]> = Vec::with_capacity(n);
+    let mut rows: Vec<&mut [CachedPair]> = Vec::with_capacity(n);
     let mut rest = buf.as_mut_slice();
     for i in 0..n {
         let (row, tail) = rest.split_at_mut(nl.of(i).len());
@@ -87,12 +87,22 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
                 }
                 let vj = vol[pair.j];
                 g += vj * pair.w;
+                let (mut dw_r, mut e) = (0.0, Vector::zeros());
                 if pair.r > 0.0 {
-                    let grad = pair.xij * (pair.dw / pair.r);
+                    dw_r = pair.dw / pair.r;
+                    e = pair.xij / pair.r;
+                    let grad = pair.xij * dw_r;
                     m += outer(-pair.xij, grad) * vj;
                     gv += outer(p.vel[pair.j] - vi, grad) * vj;
                 }
-                row[cnt] = pair;
+                row[cnt] = CachedPair {
+                    j: pair.j,
+                    xij: pair.xij,
+                    e,
+                    r: pair.r,
+                    w: pair.w,
+                    dw_r,
+                };
                 cnt += 1;
             }
             let lcorr = correction(m);
