@@ -35,9 +35,12 @@ pub(crate) struct PassedThrough {
 /// the force on each particle into `force`, the reactions into the rigid bodies' contact force
 /// and torque, the dashpot work added to `damping_work`. Reactions are collected per rigid body
 /// in particle order, so the sums do not depend on the thread count. Stops at the first pair
-/// in which a particle has passed through the primary surface, and returns it.
+/// in which a particle has passed through the primary surface, and returns it. `vol` holds the
+/// particle volumes.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn contact(
     s: SphView<'_>,
+    vol: &[f64],
     dx: f64,
     dt: f64,
     contacts: &mut [ContactPair],
@@ -87,9 +90,7 @@ pub(crate) fn contact(
                     .iter()
                     .map(|&j| j as usize)
                     .filter(|&j| p.body[j] == prim);
-                let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| {
-                    p.mass[j] / p.rho[j]
-                });
+                let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| vol[j]);
                 let det = match det {
                     Some(d) if d.penetration > 0.0 => d,
                     _ => {

@@ -17,10 +17,13 @@ struct ParticleForce {
 
 /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9, with the
 /// Shepard sums `sh`), the hourglass force (eq. 16, against the velocity gradients `gv`) and
-/// gravity, into `accel`; returns the hourglass work of the step (J/m).
+/// gravity, into `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes
+/// after the stress stage.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn forces(
     s: SphView<'_>,
     cache: &PairCache,
+    vol: &[f64],
     sh: &[f64],
     gv: &[Matrix],
     settings: &Settings,
@@ -65,7 +68,7 @@ pub(crate) fn forces(
                 };
             }
             let vi = p.vel[i];
-            let voli = p.mass[i] / p.rho[i];
+            let voli = vol[i];
             let mut a = Vector::zeros();
             let mut fhg = Vector::zeros();
             for &CachedPair {
@@ -85,7 +88,7 @@ pub(crate) fn forces(
                 if alpha > 0.0 && w > 0.0 {
                     // Not the kernel sums' volume: the stress stage has moved ρ since (continuity), and
                     // both volumes must be the same step's for a symmetric pair force.
-                    let volj = p.mass[j] / p.rho[j];
+                    let volj = vol[j];
                     // Heavily sheared material can bring two particles almost on top of
                     // each other; 1/r² then makes the pair force stiff enough to blow the
                     // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops

@@ -39,14 +39,7 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
     let SphView { p, nl, k, bc } = s;
     let w0 = k.w(0.0);
     let n = p.len();
-    sums.vol.clear();
-    sums.vol.par_extend(
-        p.mass
-            .par_iter()
-            .zip(&p.rho)
-            .par_tasks()
-            .map(|(m, r)| m / r),
-    );
+    super::volumes(p, &mut sums.vol);
     let vol = &sums.vol;
     let buf = &mut cache.pairs;
     // Rows are overwritten before they are read: grow, never clear (a memset per step).
@@ -75,7 +68,7 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
                     pairs: 0,
                 };
             }
-            let mut g = p.mass[i] / p.rho[i] * w0;
+            let mut g = vol[i] * w0;
             let mut m = Matrix::zeros();
             let vi = p.vel[i];
             let mut gv = Matrix::zeros();

@@ -60,6 +60,20 @@ pub(crate) trait ParTasks: IndexedParallelIterator {
 
 impl<I: IndexedParallelIterator> ParTasks for I {}
 
+/// Particle volumes V_i = m_i/ρ_i into `out`, taken once per particle so that no sum over pairs
+/// divides for its neighbour's volume.
+pub(crate) fn volumes(p: &Particles, out: &mut Vec<f64>) {
+    use rayon::prelude::*;
+    out.clear();
+    out.par_extend(
+        p.mass
+            .par_iter()
+            .zip(&p.rho)
+            .par_tasks()
+            .map(|(m, r)| m / r),
+    );
+}
+
 /// Per-body constants the stages need, looked up by particle.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct BodyConst {

@@ -32,6 +32,9 @@ struct Scratch {
     pairs: PairCache,
     /// Volumes, Shepard sums, correction matrices and velocity gradients of the kernel sums.
     sums: KernelSums,
+    /// Particle volumes after the stress stage: read by the forces, the contact and the density
+    /// filter, which all run before ρ changes again.
+    vol: Vec<f64>,
     /// Accelerations of the forces.
     acc: Vec<Vector>,
     /// Contact force on each particle.
@@ -268,6 +271,7 @@ impl World {
             Stage::Stress => self.stress(&bc, dt),
             Stage::Forces => self.forces(&bc, dt),
             Stage::Contact => {
+                stages::volumes(&self.particles, &mut self.scratch.vol);
                 // A surface particle passing through is a result of the state, not of timing.
                 let _ = self.contact(&bc, dt);
             }
@@ -329,8 +333,10 @@ impl World {
         if !self.nbrs_valid || self.nbrs.start.len() != self.particles.len() + 1 {
             self.rebuild_neighbours();
         }
+        stages::volumes(&self.particles, &mut self.scratch.vol);
         let s = self.sph(bc);
-        self.particles.rho = stages::filter_density(s, self.settings.density_filter);
+        let vol = &self.scratch.vol;
+        self.particles.rho = stages::filter_density(s, vol, self.settings.density_filter);
         self.work.density_filter += self.energy().elastic - before;
     }
 
@@ -378,9 +384,11 @@ impl World {
             bc,
         };
         let sc = &mut self.scratch;
+        stages::volumes(s.p, &mut sc.vol);
         let hg = stages::forces(
             s,
             &sc.pairs,
+            &sc.vol,
             &sc.sums.shepard,
             &sc.sums.gradv,
             &self.settings,
@@ -399,6 +407,7 @@ impl World {
         };
         let through = stages::contact(
             s,
+            &self.scratch.vol,
             self.settings.spacing_m,
             dt,
             &mut self.contacts,
