@@ -19,6 +19,11 @@ pub struct NeighbourLists {
     pub start: Vec<u32>,
     /// Neighbour indices.
     pub list: Vec<u32>,
+    /// For each entry of `list`: whether the pair's reference positions lie closer than the
+    /// kernel support, |X_i − X_j| < 3h, the pairs the hourglass stiffness of eq. 16 acts on. The
+    /// reference positions only change with the particle set, which forces a rebuild, so the test
+    /// is made once per build (by `build_for_bodies`; empty from `build`).
+    pub near_ref: Vec<bool>,
 }
 
 impl NeighbourLists {
@@ -91,7 +96,11 @@ pub fn build(
         list.extend_from_slice(&r);
         start.push(list.len() as u32);
     }
-    NeighbourLists { start, list }
+    NeighbourLists {
+        start,
+        list,
+        near_ref: Vec::new(),
+    }
 }
 
 /// The O(N²) reference search the cell list is tested against.
@@ -118,17 +127,23 @@ pub fn build_naive(
         }
         start.push(list.len() as u32);
     }
-    NeighbourLists { start, list }
+    NeighbourLists {
+        start,
+        list,
+        near_ref: Vec::new(),
+    }
 }
 
 /// Builds the lists of a world's particles with reach `radius`: deformable particles see their own
 /// body and the primary boundary particles they can touch; rigid secondary boundary particles
-/// see their primaries.
+/// see their primaries. Each entry is marked with whether its reference positions lie within
+/// `support`.
 pub(crate) fn build_for_bodies(
     p: &Particles,
     bodies: &[Body],
     contacts: &[ContactPair],
     radius: f64,
+    support: f64,
 ) -> NeighbourLists {
     let nb = bodies.len();
     // relation[a * nb + b]: can a particle of body a list one of body b?
@@ -160,9 +175,20 @@ pub(crate) fn build_for_bodies(
         })
         .collect();
     let body = &p.body;
-    build(&p.pos, &searcher, &candidate, radius, |i, j| {
+    let mut nl = build(&p.pos, &searcher, &candidate, radius, |i, j| {
         relation[body[i] as usize * nb + body[j] as usize]
-    })
+    });
+    let near_ref: Vec<Vec<bool>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            nl.of(i)
+                .iter()
+                .map(|&j| (p.x_ref[i] - p.x_ref[j as usize]).norm() < support)
+                .collect()
+        })
+        .collect();
+    nl.near_ref = near_ref.concat();
+    nl
 }
 
 /// Whether some particle has moved farther than `half_skin` from its position `x_build` at the
@@ -216,7 +242,8 @@ fn morton(x: u32, y: u32) -> u64 {
     spread(x) | (spread(y) << 1)
 }
 
-/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr.
+/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr,
+/// and the list's reference-distance mark.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Pair {
     pub j: usize,
@@ -224,6 +251,7 @@ pub(crate) struct Pair {
     pub r: f64,
     pub w: f64,
     pub dw: f64,
+    pub near_ref: bool,
 }
 
 /// The same-body neighbours of `i` with their kernel values: the loop every SPH sum of the
@@ -236,11 +264,13 @@ pub(crate) fn body_pairs<'a>(
 ) -> impl Iterator<Item = Pair> + 'a {
     let (bi, xi) = (p.body[i], p.pos[i]);
     let r2max = k.radius() * k.radius();
+    let s = nl.start[i] as usize;
     nl.of(i)
         .iter()
-        .map(|&j| j as usize)
-        .filter(move |&j| p.body[j] == bi)
-        .filter_map(move |j| {
+        .zip(&nl.near_ref[s..])
+        .map(|(&j, &near_ref)| (j as usize, near_ref))
+        .filter(move |&(j, _)| p.body[j] == bi)
+        .filter_map(move |(j, near_ref)| {
             let xij = xi - p.pos[j];
             let r2 = xij.norm_squared();
             // The lists reach a skin beyond the support; those pairs would add exact zeros.
@@ -249,7 +279,14 @@ pub(crate) fn body_pairs<'a>(
             }
             let r = r2.sqrt();
             let (w, dw) = k.w_dw(r);
-            Some(Pair { j, xij, r, w, dw })
+            Some(Pair {
+                j,
+                xij,
+                r,
+                w,
+                dw,
+                near_ref,
+            })
         })
 }
 
@@ -267,6 +304,8 @@ pub(crate) struct CachedPair {
     pub w: f64,
     /// dW/dr / r: the kernel gradient is x_ij times this.
     pub dw_r: f64,
+    /// Reference positions within the kernel support (`NeighbourLists::near_ref`).
+    pub near_ref: bool,
 }
 
 /// Same-body pairs of this step with their kernel values, in each particle's slice of the

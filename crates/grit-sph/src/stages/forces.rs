@@ -34,7 +34,6 @@ pub(crate) fn forces(
     let alpha = settings.hourglass;
     let g = settings.gravity_m_s2;
     let h = k.h;
-    let radius = k.radius();
     // σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
     let sig: Vec<Matrix> = (0..p.len())
         .into_par_iter()
@@ -78,6 +77,7 @@ pub(crate) fn forces(
                 r,
                 w,
                 dw_r,
+                near_ref,
             } in cache.of(nl, i)
             {
                 if r == 0.0 {
@@ -100,8 +100,8 @@ pub(crate) fn forces(
                     let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
                     let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
                     // Stiffness part: separation error against the mean deformation gradient.
-                    let xr = p.x_ref[i] - p.x_ref[j];
-                    let stiff = if xr.norm() < radius {
+                    let stiff = if near_ref {
+                        let xr = p.x_ref[i] - p.x_ref[j];
                         let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
                         c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
                     } else {

@@ -95,6 +95,7 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
                     r: pair.r,
                     w: pair.w,
                     dw_r,
+                    near_ref: pair.near_ref,
                 };
                 cnt += 1;
             }

@@ -171,8 +171,13 @@ impl World {
             }
         }
         let radius = self.neighbour_reach();
-        self.nbrs =
-            neighbours::build_for_bodies(&self.particles, &self.bodies, &self.contacts, radius);
+        self.nbrs = neighbours::build_for_bodies(
+            &self.particles,
+            &self.bodies,
+            &self.contacts,
+            radius,
+            self.kernel.radius(),
+        );
         self.x_build = self.particles.pos.clone();
         self.nbrs_valid = true;
     }
