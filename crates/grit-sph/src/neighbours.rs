@@ -246,7 +246,8 @@ fn morton(x: u32, y: u32) -> u64 {
 /// and the list's reference-distance mark.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Pair {
-    pub j: usize,
+    /// Index of the neighbour, 32 bits like the lists.
+    pub j: u32,
     pub xij: Vector,
     pub r: f64,
     pub w: f64,
@@ -268,10 +269,9 @@ pub(crate) fn body_pairs<'a>(
     nl.of(i)
         .iter()
         .zip(&nl.near_ref[s..])
-        .map(|(&j, &near_ref)| (j as usize, near_ref))
-        .filter(move |&(j, _)| p.body[j] == bi)
-        .filter_map(move |(j, near_ref)| {
-            let xij = xi - p.pos[j];
+        .filter(move |&(&j, _)| p.body[j as usize] == bi)
+        .filter_map(move |(&j, &near_ref)| {
+            let xij = xi - p.pos[j as usize];
             let r2 = xij.norm_squared();
             // The lists reach a skin beyond the support; those pairs would add exact zeros.
             if r2 >= r2max {
@@ -295,7 +295,9 @@ pub(crate) fn body_pairs<'a>(
 /// (both are 0 for coincident particles, which every sum skips).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct CachedPair {
-    pub j: usize,
+    /// Index of the neighbour, 32 bits like the lists: with the flag it fills the last word of
+    /// a 64-byte entry.
+    pub j: u32,
     /// x_ij = x_i − x_j.
     pub xij: Vector,
     /// Unit vector x_ij / r.
@@ -349,6 +351,11 @@ mod tests {
             prop_assert_eq!(a.start, b.start);
             prop_assert_eq!(a.list, b.list);
         }
+    }
+
+    #[test]
+    fn cached_pair_fills_one_cache_line() {
+        assert_eq!(std::mem::size_of::<CachedPair>(), 64);
     }
 
     #[test]

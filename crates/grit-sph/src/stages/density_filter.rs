@@ -31,6 +31,7 @@ pub(crate) fn filter_density(s: SphView<'_>, vol: &[f64], filter: DensityFilter)
             }
             let (mut num, mut den) = (p.mass[i] * w0, vol[i] * w0);
             for Pair { j, w, .. } in body_pairs(p, nl, k, i) {
+                let j = j as usize;
                 num += p.mass[j] * w;
                 den += vol[j] * w;
             }
@@ -61,6 +62,7 @@ fn mls_density(
     a[(0, 0)] = vol[i] * w0;
     b[0] = p.mass[i] * w0;
     for Pair { j, xij, w, .. } in body_pairs(p, nl, k, i) {
+        let j = j as usize;
         let q = Vector3::new(1.0, -xij.x * inv_h, -xij.y * inv_h);
         a += q * q.transpose() * (vol[j] * w);
         b += q * (p.mass[j] * w);

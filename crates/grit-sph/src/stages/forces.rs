@@ -83,6 +83,7 @@ pub(crate) fn forces(
                 if r == 0.0 {
                     continue;
                 }
+                let j = j as usize;
                 let grad = xij * dw_r;
                 a += (sig[i] + sig[j]) * grad * p.mass[j];
                 if alpha > 0.0 && w > 0.0 {

@@ -78,7 +78,8 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
                 if pair.w == 0.0 && pair.dw == 0.0 {
                     continue;
                 }
-                let vj = vol[pair.j];
+                let j = pair.j as usize;
+                let vj = vol[j];
                 g += vj * pair.w;
                 let (mut dw_r, mut e) = (0.0, Vector::zeros());
                 if pair.r > 0.0 {
@@ -86,7 +87,7 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
                     e = pair.xij / pair.r;
                     let grad = pair.xij * dw_r;
                     m += outer(-pair.xij, grad) * vj;
-                    gv += outer(p.vel[pair.j] - vi, grad) * vj;
+                    gv += outer(p.vel[j] - vi, grad) * vj;
                 }
                 row[cnt] = CachedPair {
                     j: pair.j,
