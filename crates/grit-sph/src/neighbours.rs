@@ -134,61 +134,76 @@ pub fn build_naive(
     }
 }
 
+/// The neighbour lists of a world: same-body rows for the SPH sums of the deformable bodies, and
+/// for each contact pair the rows from its secondary particles to its primary's boundary
+/// particles. Kept apart, so no loop over pairs has to sort them by body.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct WorldLists {
+    /// Same-body neighbours of every deformable particle (empty rows for rigid ones), with the
+    /// reference-distance marks.
+    pub same: NeighbourLists,
+    /// For contact pair c, the primary boundary particles each secondary particle can touch.
+    pub contact: Vec<NeighbourLists>,
+}
+
+impl WorldLists {
+    /// Number of stored pairs (each direction counted), same-body and contact.
+    pub fn pairs(&self) -> usize {
+        self.same.pairs()
+            + self
+                .contact
+                .iter()
+                .map(NeighbourLists::pairs)
+                .sum::<usize>()
+    }
+}
+
 /// Builds the lists of a world's particles with reach `radius`: deformable particles see their own
-/// body and the primary boundary particles they can touch; rigid secondary boundary particles
-/// see their primaries. Each entry is marked with whether its reference positions lie within
-/// `support`.
+/// body; for each contact pair, the secondary's particles (only its boundary particles when it is
+/// rigid) see the primary's boundary particles. Each same-body entry is marked with whether its
+/// reference positions lie within `support`.
 pub(crate) fn build_for_bodies(
     p: &Particles,
     bodies: &[Body],
     contacts: &[ContactPair],
     radius: f64,
     support: f64,
-) -> NeighbourLists {
-    let nb = bodies.len();
-    // relation[a * nb + b]: can a particle of body a list one of body b?
-    let mut relation = vec![false; nb * nb];
-    let mut is_secondary = vec![false; nb];
-    let mut is_primary = vec![false; nb];
-    for (a, body) in bodies.iter().enumerate() {
-        if !body.is_rigid() {
-            relation[a * nb + a] = true;
-        }
-    }
-    for c in contacts {
-        relation[c.secondary * nb + c.primary] = true;
-        is_secondary[c.secondary] = true;
-        is_primary[c.primary] = true;
-    }
+) -> WorldLists {
     let n = p.len();
-    let rigid: Vec<bool> = bodies.iter().map(|b| b.is_rigid()).collect();
-    let searcher: Vec<bool> = (0..n)
-        .map(|i| {
-            let b = p.body[i] as usize;
-            !rigid[b] || (is_secondary[b] && p.flags[i] & BOUNDARY != 0)
-        })
-        .collect();
-    let candidate: Vec<bool> = (0..n)
-        .map(|i| {
-            let b = p.body[i] as usize;
-            !rigid[b] || (is_primary[b] && p.flags[i] & BOUNDARY != 0)
-        })
-        .collect();
     let body = &p.body;
-    let mut nl = build(&p.pos, &searcher, &candidate, radius, |i, j| {
-        relation[body[i] as usize * nb + body[j] as usize]
+    let deformable: Vec<bool> = (0..n)
+        .map(|i| !bodies[body[i] as usize].is_rigid())
+        .collect();
+    let mut same = build(&p.pos, &deformable, &deformable, radius, |i, j| {
+        body[i] == body[j]
     });
     let near_ref: Vec<Vec<bool>> = (0..n)
         .into_par_iter()
         .map(|i| {
-            nl.of(i)
+            same.of(i)
                 .iter()
                 .map(|&j| (p.x_ref[i] - p.x_ref[j as usize]).norm() < support)
                 .collect()
         })
         .collect();
-    nl.near_ref = near_ref.concat();
-    nl
+    same.near_ref = near_ref.concat();
+    let contact = contacts
+        .iter()
+        .map(|c| {
+            let boundary_only = bodies[c.secondary].is_rigid();
+            let searcher: Vec<bool> = (0..n)
+                .map(|i| {
+                    body[i] as usize == c.secondary
+                        && (!boundary_only || p.flags[i] & BOUNDARY != 0)
+                })
+                .collect();
+            let candidate: Vec<bool> = (0..n)
+                .map(|i| body[i] as usize == c.primary && p.flags[i] & BOUNDARY != 0)
+                .collect();
+            build(&p.pos, &searcher, &candidate, radius, |_, _| true)
+        })
+        .collect();
+    WorldLists { same, contact }
 }
 
 /// Whether some particle has moved farther than `half_skin` from its position `x_build` at the
@@ -255,21 +270,20 @@ pub(crate) struct Pair {
     pub near_ref: bool,
 }
 
-/// The same-body neighbours of `i` with their kernel values: the loop every SPH sum of the
-/// deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
+/// The neighbours of `i` in the same-body lists `nl` with their kernel values: the loop every
+/// SPH sum of the deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
 pub(crate) fn body_pairs<'a>(
     p: &'a Particles,
     nl: &'a NeighbourLists,
     k: &'a Kernel,
     i: usize,
 ) -> impl Iterator<Item = Pair> + 'a {
-    let (bi, xi) = (p.body[i], p.pos[i]);
+    let xi = p.pos[i];
     let r2max = k.radius() * k.radius();
     let s = nl.start[i] as usize;
     nl.of(i)
         .iter()
         .zip(&nl.near_ref[s..])
-        .filter(move |&(&j, _)| p.body[j as usize] == bi)
         .filter_map(move |(&j, &near_ref)| {
             let xij = xi - p.pos[j as usize];
             let r2 = xij.norm_squared();

@@ -7,6 +7,7 @@ use super::{ParTasks, SphView};
 use crate::body::{Body, Motion};
 use crate::contact::{self, ContactPair};
 use crate::math::{cross, Vector};
+use crate::neighbours::NeighbourLists;
 
 /// One secondary particle's contact in this step.
 struct Hit {
@@ -36,10 +37,11 @@ pub(crate) struct PassedThrough {
 /// and torque, the dashpot work added to `damping_work`. Reactions are collected per rigid body
 /// in particle order, so the sums do not depend on the thread count. Stops at the first pair
 /// in which a particle has passed through the primary surface, and returns it. `vol` holds the
-/// particle volumes.
+/// particle volumes, `lists[c]` pair c's candidate primary particles of each secondary particle.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn contact(
     s: SphView<'_>,
+    lists: &[NeighbourLists],
     vol: &[f64],
     dx: f64,
     dt: f64,
@@ -48,7 +50,7 @@ pub(crate) fn contact(
     force: &mut Vec<Vector>,
     damping_work: &mut f64,
 ) -> Option<PassedThrough> {
-    let SphView { p, nl, k, .. } = s;
+    let SphView { p, k, .. } = s;
     let n = p.len();
     force.clear();
     force.resize(n, Vector::zeros());
@@ -59,7 +61,8 @@ pub(crate) fn contact(
         }
     }
     for (ci, c) in contacts.iter_mut().enumerate() {
-        let (prim, sec) = (c.primary as u32, c.secondary as u32);
+        let nl = &lists[ci];
+        let sec = c.secondary as u32;
         let (k_r, k_f, mu, zeta, model) = (
             c.k_r,
             c.k_f,
@@ -85,11 +88,7 @@ pub(crate) fn contact(
                 if p.body[i] != sec {
                     return None;
                 }
-                let js = nl
-                    .of(i)
-                    .iter()
-                    .map(|&j| j as usize)
-                    .filter(|&j| p.body[j] == prim);
+                let js = nl.of(i).iter().map(|&j| j as usize);
                 let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| vol[j]);
                 let det = match det {
                     Some(d) if d.penetration > 0.0 => d,

@@ -20,7 +20,7 @@ use crate::contact::{ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::kernel::Kernel;
 use crate::math::Vector;
-use crate::neighbours::{self, NeighbourLists, PairCache};
+use crate::neighbours::{self, PairCache, WorldLists};
 use crate::particles::Particles;
 use crate::stages::{self, Blowup, BodyConst, KernelSums, PassedThrough, SphView};
 use crate::timers::{Stage, Timers};
@@ -57,7 +57,7 @@ pub struct World {
     /// Positions at the last neighbour build.
     x_build: Vec<Vector>,
     #[serde(skip)]
-    nbrs: NeighbourLists,
+    nbrs: WorldLists,
     #[serde(skip)]
     nbrs_valid: bool,
     #[serde(skip)]
@@ -83,7 +83,7 @@ impl World {
             next_id: 0,
             work: NumericalWork::default(),
             x_build: Vec::new(),
-            nbrs: NeighbourLists::default(),
+            nbrs: WorldLists::default(),
             nbrs_valid: false,
             scratch: Scratch::default(),
             timers: Timers::default(),
@@ -335,7 +335,7 @@ impl World {
 
     fn filter_density_with(&mut self, bc: &[BodyConst]) {
         let before = self.energy().elastic;
-        if !self.nbrs_valid || self.nbrs.start.len() != self.particles.len() + 1 {
+        if !self.nbrs_valid || self.nbrs.same.start.len() != self.particles.len() + 1 {
             self.rebuild_neighbours();
         }
         stages::volumes(&self.particles, &mut self.scratch.vol);
@@ -352,7 +352,7 @@ impl World {
     fn sph<'a>(&'a self, bc: &'a [BodyConst]) -> SphView<'a> {
         SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         }
@@ -361,7 +361,7 @@ impl World {
     fn kernel_sums(&mut self, bc: &[BodyConst]) {
         let s = SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         };
@@ -384,7 +384,7 @@ impl World {
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
         let s = SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         };
@@ -406,12 +406,13 @@ impl World {
     fn contact(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
         let s = SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         };
         let through = stages::contact(
             s,
+            &self.nbrs.contact,
             &self.scratch.vol,
             self.settings.spacing_m,
             dt,
