@@ -39,12 +39,105 @@ impl NeighbourLists {
     }
 }
 
+/// The candidate points of a neighbour search grouped by cell: `members(c)` lists the points
+/// of cell `c` in increasing index order.
+enum Cells {
+    /// A dense grid over the candidates' bounding box, filled by a counting sort in O(n).
+    Grid {
+        lo: (i64, i64),
+        nx: i64,
+        ny: i64,
+        /// Start of each cell's members in `idx`, row-major by (y, x); length nx·ny + 1.
+        start: Vec<u32>,
+        idx: Vec<u32>,
+    },
+    /// The occupied cells' keys, sorted row-major by (y, x), with the members in the same order:
+    /// for points spread so far apart (a fragment flung off) that a grid would be mostly empty.
+    Sorted {
+        keys: Vec<(i64, i64)>,
+        idx: Vec<u32>,
+    },
+}
+
+impl Cells {
+    /// Groups the points `keys[k]` (cell of point `idx[k]`, indices increasing) by cell.
+    fn new(keys: Vec<(i64, i64)>, idx: Vec<u32>) -> Cells {
+        let Some(&first) = keys.first() else {
+            return Cells::Sorted { keys, idx };
+        };
+        let (lo, hi) = keys.iter().fold((first, first), |(lo, hi), &(x, y)| {
+            ((lo.0.min(x), lo.1.min(y)), (hi.0.max(x), hi.1.max(y)))
+        });
+        let nx = hi.0 as i128 - lo.0 as i128 + 1;
+        let ny = hi.1 as i128 - lo.1 as i128 + 1;
+        // A grid a few times the point count costs about as much to clear as to fill.
+        if nx * ny > 4 * keys.len() as i128 + 64 {
+            let mut order: Vec<usize> = (0..keys.len()).collect();
+            order.sort_unstable_by_key(|&k| (keys[k].1, keys[k].0, idx[k]));
+            return Cells::Sorted {
+                keys: order.iter().map(|&k| keys[k]).collect(),
+                idx: order.iter().map(|&k| idx[k]).collect(),
+            };
+        }
+        let (nx, ny) = (nx as i64, ny as i64);
+        let cell = |(x, y): (i64, i64)| ((y - lo.1) * nx + (x - lo.0)) as usize;
+        let mut start = vec![0u32; (nx * ny) as usize + 1];
+        for &c in &keys {
+            start[cell(c) + 1] += 1;
+        }
+        for c in 1..start.len() {
+            start[c] += start[c - 1];
+        }
+        // Scattered in index order, so each cell's members stay in increasing index order.
+        let mut fill = start.clone();
+        let mut sorted = vec![0u32; idx.len()];
+        for (&c, &j) in keys.iter().zip(&idx) {
+            let f = &mut fill[cell(c)];
+            sorted[*f as usize] = j;
+            *f += 1;
+        }
+        Cells::Grid {
+            lo,
+            nx,
+            ny,
+            start,
+            idx: sorted,
+        }
+    }
+
+    /// The points in cell `(x, y)`.
+    fn members(&self, (x, y): (i64, i64)) -> &[u32] {
+        match self {
+            Cells::Grid {
+                lo,
+                nx,
+                ny,
+                start,
+                idx,
+            } => {
+                let (gx, gy) = (x - lo.0, y - lo.1);
+                if gx < 0 || gy < 0 || gx >= *nx || gy >= *ny {
+                    return &[];
+                }
+                let c = (gy * nx + gx) as usize;
+                &idx[start[c] as usize..start[c + 1] as usize]
+            }
+            Cells::Sorted { keys, idx } => {
+                let a = keys.partition_point(|&(kx, ky)| (ky, kx) < (y, x));
+                let b = a + keys[a..].partition_point(|&(kx, ky)| (ky, kx) <= (y, x));
+                &idx[a..b]
+            }
+        }
+    }
+}
+
 /// Builds neighbour lists with a cell list of cell size `radius`.
 ///
 /// `searcher[i]` says whether `i` gets a list; `candidate[j]` whether `j` can be listed;
-/// `accept(i, j)` filters pairs further (bodies that never interact). Points farther than
-/// `radius` are never listed. Cells are found by binary search in the sorted cell keys, so a
-/// particle flying far away costs nothing in memory.
+/// `accept(i, j)` filters pairs further. Points farther than `radius` are never listed. The
+/// candidates are grouped by cell with a counting sort over their bounding box, or, when a
+/// point far off would make that grid mostly empty, by sorting the occupied cells, so a particle
+/// flying far away costs nothing in memory.
 pub fn build(
     pos: &[Vector],
     searcher: &[bool],
@@ -55,12 +148,12 @@ pub fn build(
     let inv = 1.0 / radius;
     let key =
         |p: &Vector| -> (i64, i64) { ((p.x * inv).floor() as i64, (p.y * inv).floor() as i64) };
-    let mut cells: Vec<((i64, i64), u32)> = (0..pos.len())
+    let idx: Vec<u32> = (0..pos.len())
         .filter(|&j| candidate[j])
-        .map(|j| (key(&pos[j]), j as u32))
+        .map(|j| j as u32)
         .collect();
-    // Row-major by (y, x) then index: neighbours come out sorted by cell, then by index.
-    cells.sort_unstable_by_key(|&((cx, cy), j)| (cy, cx, j));
+    let keys: Vec<(i64, i64)> = idx.iter().map(|&j| key(&pos[j as usize])).collect();
+    let cells = Cells::new(keys, idx);
     let r2 = radius * radius;
     let rows: Vec<Vec<u32>> = (0..pos.len())
         .into_par_iter()
@@ -72,12 +165,7 @@ pub fn build(
             let mut out = Vec::new();
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    let c = (cy + dy, cx + dx);
-                    let lo = cells.partition_point(|&((x, y), _)| (y, x) < c);
-                    for &((x, y), j) in &cells[lo..] {
-                        if (y, x) != c {
-                            break;
-                        }
+                    for &j in cells.members((cx + dx, cy + dy)) {
                         let j = j as usize;
                         if j != i && (pos[j] - pos[i]).norm_squared() <= r2 && accept(i, j) {
                             out.push(j as u32);
@@ -85,6 +173,8 @@ pub fn build(
                     }
                 }
             }
+            // Cell by cell, then by index: sorted by index, every sum over a row runs in one
+            // fixed order.
             out.sort_unstable();
             out
         })
@@ -365,6 +455,20 @@ mod tests {
             prop_assert_eq!(a.start, b.start);
             prop_assert_eq!(a.list, b.list);
         }
+    }
+
+    #[test]
+    fn far_flung_point_takes_the_sorted_cells_and_lists_the_same() {
+        let mut pos: Vec<Vector> = (0..200)
+            .map(|k| Vector::new((k % 20) as f64 * 0.3, (k / 20) as f64 * 0.3))
+            .collect();
+        pos.push(Vector::new(1e12, -1e12));
+        pos.push(Vector::new(1e12 + 0.2, -1e12));
+        let all = vec![true; pos.len()];
+        let a = build(&pos, &all, &all, 0.7, |_, _| true);
+        let b = build_naive(&pos, &all, &all, 0.7, |_, _| true);
+        assert_eq!(a.start, b.start);
+        assert_eq!(a.list, b.list);
     }
 
     #[test]
