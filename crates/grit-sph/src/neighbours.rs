@@ -233,25 +233,36 @@ pub(crate) struct WorldLists {
     /// reference-distance marks.
     pub same: NeighbourLists,
     /// For contact pair c, the primary boundary particles each secondary particle can touch.
-    pub contact: Vec<NeighbourLists>,
+    pub contact: Vec<ContactLists>,
 }
 
 impl WorldLists {
     /// Number of stored pairs (each direction counted), same-body and contact.
     pub fn pairs(&self) -> usize {
-        self.same.pairs()
-            + self
-                .contact
-                .iter()
-                .map(NeighbourLists::pairs)
-                .sum::<usize>()
+        self.same.pairs() + self.contact.iter().map(|c| c.rows.pairs()).sum::<usize>()
     }
+}
+
+/// The contact candidates of one contact pair: only the secondary particles near the primary
+/// have any, so the rows are kept for those alone.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ContactLists {
+    /// Secondary particles with at least one primary boundary particle within reach, in
+    /// increasing index order.
+    pub particles: Vec<u32>,
+    /// Row k: the primary boundary particles within reach of `particles[k]`, in index order.
+    pub rows: NeighbourLists,
+    /// Whether the secondary particles without candidates still have to have their contact
+    /// springs cleared, as a contact stage does for a particle it finds nothing for; needed
+    /// once after each build, since only particles with candidates ever get a spring.
+    pub sweep: bool,
 }
 
 /// Builds the lists of a world's particles with reach `radius`: deformable particles see their own
 /// body; for each contact pair, the secondary's particles (only its boundary particles when it is
-/// rigid) see the primary's boundary particles. Each same-body entry is marked with whether its
-/// reference positions lie within `support`.
+/// rigid) see the primary's boundary particles. Only secondary particles inside the bounding box
+/// of those boundary particles, widened by twice the reach, can list one, so only they search. Each
+/// same-body entry is marked with whether its reference positions lie within `support`.
 pub(crate) fn build_for_bodies(
     p: &Particles,
     bodies: &[Body],
@@ -281,16 +292,45 @@ pub(crate) fn build_for_bodies(
         .iter()
         .map(|c| {
             let boundary_only = bodies[c.secondary].is_rigid();
-            let searcher: Vec<bool> = (0..n)
-                .map(|i| {
-                    body[i] as usize == c.secondary
-                        && (!boundary_only || p.flags[i] & BOUNDARY != 0)
-                })
-                .collect();
             let candidate: Vec<bool> = (0..n)
                 .map(|i| body[i] as usize == c.primary && p.flags[i] & BOUNDARY != 0)
                 .collect();
-            build(&p.pos, &searcher, &candidate, radius, |_, _| true)
+            let inf = Vector::repeat(f64::INFINITY);
+            let (lo, hi) = (0..n)
+                .filter(|&j| candidate[j])
+                .fold((inf, -inf), |(lo, hi), j| {
+                    (lo.inf(&p.pos[j]), hi.sup(&p.pos[j]))
+                });
+            // Twice the reach: a margin no rounding of the distance test can cross.
+            let (lo, hi) = (lo.add_scalar(-2.0 * radius), hi.add_scalar(2.0 * radius));
+            let searcher: Vec<bool> = (0..n)
+                .map(|i| {
+                    let x = p.pos[i];
+                    body[i] as usize == c.secondary
+                        && (!boundary_only || p.flags[i] & BOUNDARY != 0)
+                        && x.x >= lo.x
+                        && x.y >= lo.y
+                        && x.x <= hi.x
+                        && x.y <= hi.y
+                })
+                .collect();
+            let all = build(&p.pos, &searcher, &candidate, radius, |_, _| true);
+            let particles: Vec<u32> = (0..n)
+                .filter(|&i| !all.of(i).is_empty())
+                .map(|i| i as u32)
+                .collect();
+            let mut start = Vec::with_capacity(particles.len() + 1);
+            start.push(0);
+            start.extend(particles.iter().map(|&i| all.start[i as usize + 1]));
+            ContactLists {
+                particles,
+                rows: NeighbourLists {
+                    start,
+                    list: all.list,
+                    near_ref: Vec::new(),
+                },
+                sweep: true,
+            }
         })
         .collect();
     WorldLists { same, contact }

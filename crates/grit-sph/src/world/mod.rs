@@ -412,7 +412,7 @@ impl World {
         };
         let through = stages::contact(
             s,
-            &self.nbrs.contact,
+            &mut self.nbrs.contact,
             &self.scratch.vol,
             self.settings.spacing_m,
             dt,
