@@ -19,6 +19,11 @@ pub struct NeighbourLists {
     pub start: Vec<u32>,
     /// Neighbour indices.
     pub list: Vec<u32>,
+    /// For each entry of `list`: whether the pair's reference positions lie closer than the
+    /// kernel support, |X_i − X_j| < 3h, the pairs the hourglass stiffness of eq. 16 acts on. The
+    /// reference positions only change with the particle set, which forces a rebuild, so the test
+    /// is made once per build (by `build_for_bodies`; empty from `build`).
+    pub near_ref: Vec<bool>,
 }
 
 impl NeighbourLists {
@@ -34,12 +39,105 @@ impl NeighbourLists {
     }
 }
 
+/// The candidate points of a neighbour search grouped by cell: `members(c)` lists the points
+/// of cell `c` in increasing index order.
+enum Cells {
+    /// A dense grid over the candidates' bounding box, filled by a counting sort in O(n).
+    Grid {
+        lo: (i64, i64),
+        nx: i64,
+        ny: i64,
+        /// Start of each cell's members in `idx`, row-major by (y, x); length nx·ny + 1.
+        start: Vec<u32>,
+        idx: Vec<u32>,
+    },
+    /// The occupied cells' keys, sorted row-major by (y, x), with the members in the same order:
+    /// for points spread so far apart (a fragment flung off) that a grid would be mostly empty.
+    Sorted {
+        keys: Vec<(i64, i64)>,
+        idx: Vec<u32>,
+    },
+}
+
+impl Cells {
+    /// Groups the points `keys[k]` (cell of point `idx[k]`, indices increasing) by cell.
+    fn new(keys: Vec<(i64, i64)>, idx: Vec<u32>) -> Cells {
+        let Some(&first) = keys.first() else {
+            return Cells::Sorted { keys, idx };
+        };
+        let (lo, hi) = keys.iter().fold((first, first), |(lo, hi), &(x, y)| {
+            ((lo.0.min(x), lo.1.min(y)), (hi.0.max(x), hi.1.max(y)))
+        });
+        let nx = hi.0 as i128 - lo.0 as i128 + 1;
+        let ny = hi.1 as i128 - lo.1 as i128 + 1;
+        // A grid a few times the point count costs about as much to clear as to fill.
+        if nx * ny > 4 * keys.len() as i128 + 64 {
+            let mut order: Vec<usize> = (0..keys.len()).collect();
+            order.sort_unstable_by_key(|&k| (keys[k].1, keys[k].0, idx[k]));
+            return Cells::Sorted {
+                keys: order.iter().map(|&k| keys[k]).collect(),
+                idx: order.iter().map(|&k| idx[k]).collect(),
+            };
+        }
+        let (nx, ny) = (nx as i64, ny as i64);
+        let cell = |(x, y): (i64, i64)| ((y - lo.1) * nx + (x - lo.0)) as usize;
+        let mut start = vec![0u32; (nx * ny) as usize + 1];
+        for &c in &keys {
+            start[cell(c) + 1] += 1;
+        }
+        for c in 1..start.len() {
+            start[c] += start[c - 1];
+        }
+        // Scattered in index order, so each cell's members stay in increasing index order.
+        let mut fill = start.clone();
+        let mut sorted = vec![0u32; idx.len()];
+        for (&c, &j) in keys.iter().zip(&idx) {
+            let f = &mut fill[cell(c)];
+            sorted[*f as usize] = j;
+            *f += 1;
+        }
+        Cells::Grid {
+            lo,
+            nx,
+            ny,
+            start,
+            idx: sorted,
+        }
+    }
+
+    /// The points in cell `(x, y)`.
+    fn members(&self, (x, y): (i64, i64)) -> &[u32] {
+        match self {
+            Cells::Grid {
+                lo,
+                nx,
+                ny,
+                start,
+                idx,
+            } => {
+                let (gx, gy) = (x - lo.0, y - lo.1);
+                if gx < 0 || gy < 0 || gx >= *nx || gy >= *ny {
+                    return &[];
+                }
+                let c = (gy * nx + gx) as usize;
+                &idx[start[c] as usize..start[c + 1] as usize]
+            }
+            Cells::Sorted { keys, idx } => {
+                let a = keys.partition_point(|&(kx, ky)| (ky, kx) < (y, x));
+                let b = a + keys[a..].partition_point(|&(kx, ky)| (ky, kx) <= (y, x));
+                &idx[a..b]
+            }
+        }
+    }
+}
+
 /// Builds neighbour lists with a cell list of cell size `radius`.
 ///
 /// `searcher[i]` says whether `i` gets a list; `candidate[j]` whether `j` can be listed;
-/// `accept(i, j)` filters pairs further (bodies that never interact). Points farther than
-/// `radius` are never listed. Cells are found by binary search in the sorted cell keys, so a
-/// particle flying far away costs nothing in memory.
+/// `accept(i, j)` filters pairs further. Points farther than `radius` are never listed. The
+/// candidates are grouped by cell with a counting sort over their bounding box, or, when a
+/// point far off would make that grid mostly empty, by sorting the occupied cells, so a particle
+/// flying far away costs nothing in memory.
 pub fn build(
     pos: &[Vector],
     searcher: &[bool],
@@ -50,12 +148,12 @@ pub fn build(
     let inv = 1.0 / radius;
     let key =
         |p: &Vector| -> (i64, i64) { ((p.x * inv).floor() as i64, (p.y * inv).floor() as i64) };
-    let mut cells: Vec<((i64, i64), u32)> = (0..pos.len())
+    let idx: Vec<u32> = (0..pos.len())
         .filter(|&j| candidate[j])
-        .map(|j| (key(&pos[j]), j as u32))
+        .map(|j| j as u32)
         .collect();
-    // Row-major by (y, x) then index: neighbours come out sorted by cell, then by index.
-    cells.sort_unstable_by_key(|&((cx, cy), j)| (cy, cx, j));
+    let keys: Vec<(i64, i64)> = idx.iter().map(|&j| key(&pos[j as usize])).collect();
+    let cells = Cells::new(keys, idx);
     let r2 = radius * radius;
     let rows: Vec<Vec<u32>> = (0..pos.len())
         .into_par_iter()
@@ -67,12 +165,7 @@ pub fn build(
             let mut out = Vec::new();
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    let c = (cy + dy, cx + dx);
-                    let lo = cells.partition_point(|&((x, y), _)| (y, x) < c);
-                    for &((x, y), j) in &cells[lo..] {
-                        if (y, x) != c {
-                            break;
-                        }
+                    for &j in cells.members((cx + dx, cy + dy)) {
                         let j = j as usize;
                         if j != i && (pos[j] - pos[i]).norm_squared() <= r2 && accept(i, j) {
                             out.push(j as u32);
@@ -80,6 +173,8 @@ pub fn build(
                     }
                 }
             }
+            // Cell by cell, then by index: sorted by index, every sum over a row runs in one
+            // fixed order.
             out.sort_unstable();
             out
         })
@@ -91,7 +186,11 @@ pub fn build(
         list.extend_from_slice(&r);
         start.push(list.len() as u32);
     }
-    NeighbourLists { start, list }
+    NeighbourLists {
+        start,
+        list,
+        near_ref: Vec::new(),
+    }
 }
 
 /// The O(N²) reference search the cell list is tested against.
@@ -118,51 +217,123 @@ pub fn build_naive(
         }
         start.push(list.len() as u32);
     }
-    NeighbourLists { start, list }
+    NeighbourLists {
+        start,
+        list,
+        near_ref: Vec::new(),
+    }
+}
+
+/// The neighbour lists of a world: same-body rows for the SPH sums of the deformable bodies, and
+/// for each contact pair the rows from its secondary particles to its primary's boundary
+/// particles. Kept apart, so no loop over pairs has to sort them by body.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct WorldLists {
+    /// Same-body neighbours of every deformable particle (empty rows for rigid ones), with the
+    /// reference-distance marks.
+    pub same: NeighbourLists,
+    /// For contact pair c, the primary boundary particles each secondary particle can touch.
+    pub contact: Vec<ContactLists>,
+}
+
+impl WorldLists {
+    /// Number of stored pairs (each direction counted), same-body and contact.
+    pub fn pairs(&self) -> usize {
+        self.same.pairs() + self.contact.iter().map(|c| c.rows.pairs()).sum::<usize>()
+    }
+}
+
+/// The contact candidates of one contact pair: only the secondary particles near the primary
+/// have any, so the rows are kept for those alone.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ContactLists {
+    /// Secondary particles with at least one primary boundary particle within reach, in
+    /// increasing index order.
+    pub particles: Vec<u32>,
+    /// Row k: the primary boundary particles within reach of `particles[k]`, in index order.
+    pub rows: NeighbourLists,
+    /// Whether the secondary particles without candidates still have to have their contact
+    /// springs cleared, as a contact stage does for a particle it finds nothing for; needed
+    /// once after each build, since only particles with candidates ever get a spring.
+    pub sweep: bool,
 }
 
 /// Builds the lists of a world's particles with reach `radius`: deformable particles see their own
-/// body and the primary boundary particles they can touch; rigid secondary boundary particles
-/// see their primaries.
+/// body; for each contact pair, the secondary's particles (only its boundary particles when it is
+/// rigid) see the primary's boundary particles. Only secondary particles inside the bounding box
+/// of those boundary particles, widened by twice the reach, can list one, so only they search. Each
+/// same-body entry is marked with whether its reference positions lie within `support`.
 pub(crate) fn build_for_bodies(
     p: &Particles,
     bodies: &[Body],
     contacts: &[ContactPair],
     radius: f64,
-) -> NeighbourLists {
-    let nb = bodies.len();
-    // relation[a * nb + b]: can a particle of body a list one of body b?
-    let mut relation = vec![false; nb * nb];
-    let mut is_secondary = vec![false; nb];
-    let mut is_primary = vec![false; nb];
-    for (a, body) in bodies.iter().enumerate() {
-        if !body.is_rigid() {
-            relation[a * nb + a] = true;
-        }
-    }
-    for c in contacts {
-        relation[c.secondary * nb + c.primary] = true;
-        is_secondary[c.secondary] = true;
-        is_primary[c.primary] = true;
-    }
+    support: f64,
+) -> WorldLists {
     let n = p.len();
-    let rigid: Vec<bool> = bodies.iter().map(|b| b.is_rigid()).collect();
-    let searcher: Vec<bool> = (0..n)
-        .map(|i| {
-            let b = p.body[i] as usize;
-            !rigid[b] || (is_secondary[b] && p.flags[i] & BOUNDARY != 0)
-        })
-        .collect();
-    let candidate: Vec<bool> = (0..n)
-        .map(|i| {
-            let b = p.body[i] as usize;
-            !rigid[b] || (is_primary[b] && p.flags[i] & BOUNDARY != 0)
-        })
-        .collect();
     let body = &p.body;
-    build(&p.pos, &searcher, &candidate, radius, |i, j| {
-        relation[body[i] as usize * nb + body[j] as usize]
-    })
+    let deformable: Vec<bool> = (0..n)
+        .map(|i| !bodies[body[i] as usize].is_rigid())
+        .collect();
+    let mut same = build(&p.pos, &deformable, &deformable, radius, |i, j| {
+        body[i] == body[j]
+    });
+    let near_ref: Vec<Vec<bool>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            same.of(i)
+                .iter()
+                .map(|&j| (p.x_ref[i] - p.x_ref[j as usize]).norm() < support)
+                .collect()
+        })
+        .collect();
+    same.near_ref = near_ref.concat();
+    let contact = contacts
+        .iter()
+        .map(|c| {
+            let boundary_only = bodies[c.secondary].is_rigid();
+            let candidate: Vec<bool> = (0..n)
+                .map(|i| body[i] as usize == c.primary && p.flags[i] & BOUNDARY != 0)
+                .collect();
+            let inf = Vector::repeat(f64::INFINITY);
+            let (lo, hi) = (0..n)
+                .filter(|&j| candidate[j])
+                .fold((inf, -inf), |(lo, hi), j| {
+                    (lo.inf(&p.pos[j]), hi.sup(&p.pos[j]))
+                });
+            // Twice the reach: a margin no rounding of the distance test can cross.
+            let (lo, hi) = (lo.add_scalar(-2.0 * radius), hi.add_scalar(2.0 * radius));
+            let searcher: Vec<bool> = (0..n)
+                .map(|i| {
+                    let x = p.pos[i];
+                    body[i] as usize == c.secondary
+                        && (!boundary_only || p.flags[i] & BOUNDARY != 0)
+                        && x.x >= lo.x
+                        && x.y >= lo.y
+                        && x.x <= hi.x
+                        && x.y <= hi.y
+                })
+                .collect();
+            let all = build(&p.pos, &searcher, &candidate, radius, |_, _| true);
+            let particles: Vec<u32> = (0..n)
+                .filter(|&i| !all.of(i).is_empty())
+                .map(|i| i as u32)
+                .collect();
+            let mut start = Vec::with_capacity(particles.len() + 1);
+            start.push(0);
+            start.extend(particles.iter().map(|&i| all.start[i as usize + 1]));
+            ContactLists {
+                particles,
+                rows: NeighbourLists {
+                    start,
+                    list: all.list,
+                    near_ref: Vec::new(),
+                },
+                sweep: true,
+            }
+        })
+        .collect();
+    WorldLists { same, contact }
 }
 
 /// Whether some particle has moved farther than `half_skin` from its position `x_build` at the
@@ -216,32 +387,35 @@ fn morton(x: u32, y: u32) -> u64 {
     spread(x) | (spread(y) << 1)
 }
 
-/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr.
+/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr,
+/// and the list's reference-distance mark.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Pair {
-    pub j: usize,
+    /// Index of the neighbour, 32 bits like the lists.
+    pub j: u32,
     pub xij: Vector,
     pub r: f64,
     pub w: f64,
     pub dw: f64,
+    pub near_ref: bool,
 }
 
-/// The same-body neighbours of `i` with their kernel values: the loop every SPH sum of the
-/// deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
+/// The neighbours of `i` in the same-body lists `nl` with their kernel values: the loop every
+/// SPH sum of the deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
 pub(crate) fn body_pairs<'a>(
     p: &'a Particles,
     nl: &'a NeighbourLists,
     k: &'a Kernel,
     i: usize,
 ) -> impl Iterator<Item = Pair> + 'a {
-    let (bi, xi) = (p.body[i], p.pos[i]);
+    let xi = p.pos[i];
     let r2max = k.radius() * k.radius();
+    let s = nl.start[i] as usize;
     nl.of(i)
         .iter()
-        .map(|&j| j as usize)
-        .filter(move |&j| p.body[j] == bi)
-        .filter_map(move |j| {
-            let xij = xi - p.pos[j];
+        .zip(&nl.near_ref[s..])
+        .filter_map(move |(&j, &near_ref)| {
+            let xij = xi - p.pos[j as usize];
             let r2 = xij.norm_squared();
             // The lists reach a skin beyond the support; those pairs would add exact zeros.
             if r2 >= r2max {
@@ -249,17 +423,44 @@ pub(crate) fn body_pairs<'a>(
             }
             let r = r2.sqrt();
             let (w, dw) = k.w_dw(r);
-            Some(Pair { j, xij, r, w, dw })
+            Some(Pair {
+                j,
+                xij,
+                r,
+                w,
+                dw,
+                near_ref,
+            })
         })
+}
+
+/// A same-body pair inside the kernel support as the kernel sums leave it for the forces: the
+/// quotients dW/dr / r and x_ij / r are taken once here, so no later stage divides by r again
+/// (both are 0 for coincident particles, which every sum skips).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct CachedPair {
+    /// Index of the neighbour, 32 bits like the lists: with the flag it fills the last word of
+    /// a 64-byte entry.
+    pub j: u32,
+    /// x_ij = x_i − x_j.
+    pub xij: Vector,
+    /// Unit vector x_ij / r.
+    pub e: Vector,
+    pub r: f64,
+    pub w: f64,
+    /// dW/dr / r: the kernel gradient is x_ij times this.
+    pub dw_r: f64,
+    /// Reference positions within the kernel support (`NeighbourLists::near_ref`).
+    pub near_ref: bool,
 }
 
 /// Same-body pairs of this step with their kernel values, in each particle's slice of the
 /// neighbour rows (first `count[i]` entries used): computed once in the kernel sums, read by the
-/// rates and the forces, so each pair's kernel is evaluated once per step.
+/// forces, so each pair's kernel is evaluated once per step.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PairCache {
     /// Pairs, laid out like the neighbour rows.
-    pub pairs: Vec<Pair>,
+    pub pairs: Vec<CachedPair>,
     /// Pairs used in each particle's row.
     pub count: Vec<u32>,
 }
@@ -267,7 +468,7 @@ pub(crate) struct PairCache {
 impl PairCache {
     /// The cached same-body pairs of particle `i` (filled by the kernel sums this step).
     #[inline]
-    pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [Pair] {
+    pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [CachedPair] {
         let s = nl.start[i] as usize;
         &self.pairs[s..s + self.count[i] as usize]
     }
@@ -294,6 +495,25 @@ mod tests {
             prop_assert_eq!(a.start, b.start);
             prop_assert_eq!(a.list, b.list);
         }
+    }
+
+    #[test]
+    fn far_flung_point_takes_the_sorted_cells_and_lists_the_same() {
+        let mut pos: Vec<Vector> = (0..200)
+            .map(|k| Vector::new((k % 20) as f64 * 0.3, (k / 20) as f64 * 0.3))
+            .collect();
+        pos.push(Vector::new(1e12, -1e12));
+        pos.push(Vector::new(1e12 + 0.2, -1e12));
+        let all = vec![true; pos.len()];
+        let a = build(&pos, &all, &all, 0.7, |_, _| true);
+        let b = build_naive(&pos, &all, &all, 0.7, |_, _| true);
+        assert_eq!(a.start, b.start);
+        assert_eq!(a.list, b.list);
+    }
+
+    #[test]
+    fn cached_pair_fills_one_cache_line() {
+        assert_eq!(std::mem::size_of::<CachedPair>(), 64);
     }
 
     #[test]

@@ -10,7 +10,9 @@ pub enum Stage {
     Neighbours,
     /// Shepard sums and correction matrices L (eqs. 8, 9).
     KernelSums,
-    /// Velocity gradient and density rate (eqs. 5, 14, 15).
+    /// Velocity gradient and density rate (eqs. 5, 14, 15). `World::step` sums them in the kernel
+    /// sums' pass and books their time there, so this counter stays at zero in a step;
+    /// `World::run_stage` runs that pass.
     Rates,
     /// EOS, Jaumann rate, return mapping, heating, damage (eqs. 11, 13, 18–20).
     Stress,

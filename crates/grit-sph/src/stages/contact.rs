@@ -7,6 +7,7 @@ use super::{ParTasks, SphView};
 use crate::body::{Body, Motion};
 use crate::contact::{self, ContactPair};
 use crate::math::{cross, Vector};
+use crate::neighbours::ContactLists;
 
 /// One secondary particle's contact in this step.
 struct Hit {
@@ -18,6 +19,16 @@ struct Hit {
     distance: f64,
     /// Work of the contact dashpot over the step (J/m).
     damping_work: f64,
+}
+
+/// A secondary particle's contact state after this step, and its hit if it is in contact.
+#[derive(Default)]
+struct Outcome {
+    /// Friction spring Δl (eq. 25); zero out of contact.
+    spring: Vector,
+    /// Penetration P (eq. 23); zero out of contact.
+    penetration: f64,
+    hit: Option<Hit>,
 }
 
 /// A secondary particle found on the far side of a primary surface: the step has failed.
@@ -35,9 +46,15 @@ pub(crate) struct PassedThrough {
 /// the force on each particle into `force`, the reactions into the rigid bodies' contact force
 /// and torque, the dashpot work added to `damping_work`. Reactions are collected per rigid body
 /// in particle order, so the sums do not depend on the thread count. Stops at the first pair
-/// in which a particle has passed through the primary surface, and returns it.
+/// in which a particle has passed through the primary surface, and returns it. `vol` holds the
+/// particle volumes, `lists[c]` pair c's candidate primary particles of the secondary particles
+/// near the primary. A secondary particle without candidates is out of contact: its spring and
+/// penetration are zero (they are cleared once after each build, `ContactLists::sweep`).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn contact(
     s: SphView<'_>,
+    lists: &mut [ContactLists],
+    vol: &[f64],
     dx: f64,
     dt: f64,
     contacts: &mut [ContactPair],
@@ -45,7 +62,7 @@ pub(crate) fn contact(
     force: &mut Vec<Vector>,
     damping_work: &mut f64,
 ) -> Option<PassedThrough> {
-    let SphView { p, nl, k, .. } = s;
+    let SphView { p, k, .. } = s;
     let n = p.len();
     force.clear();
     force.resize(n, Vector::zeros());
@@ -56,7 +73,19 @@ pub(crate) fn contact(
         }
     }
     for (ci, c) in contacts.iter_mut().enumerate() {
-        let (prim, sec) = (c.primary as u32, c.secondary as u32);
+        let cl = &mut lists[ci];
+        let sec = c.secondary as u32;
+        if cl.sweep {
+            let mut listed = cl.particles.iter().peekable();
+            for i in 0..n {
+                if listed.next_if_eq(&&(i as u32)).is_none() && p.body[i] == sec {
+                    c.spring[i] = Vector::zeros();
+                    c.penetration[i] = 0.0;
+                }
+            }
+            cl.sweep = false;
+        }
+        let nl = &cl.rows;
         let (k_r, k_f, mu, zeta, model) = (
             c.k_r,
             c.k_f,
@@ -72,34 +101,22 @@ pub(crate) fn contact(
             bodies[c.secondary].rigid().map(|r| r.motion),
             Some(Motion::Fixed)
         );
-        let hits: Vec<Option<Hit>> = c
-            .spring
-            .par_iter_mut()
-            .zip(c.penetration.par_iter_mut())
+        let (spring, penetration) = (&c.spring, &c.penetration);
+        let outcomes: Vec<Outcome> = cl
+            .particles
+            .par_iter()
             .par_tasks()
             .enumerate()
-            .map(|(i, (dl, pen_prev))| {
-                if p.body[i] != sec {
-                    return None;
-                }
-                let js = nl
-                    .of(i)
-                    .iter()
-                    .map(|&j| j as usize)
-                    .filter(|&j| p.body[j] == prim);
-                let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| {
-                    p.mass[j] / p.rho[j]
-                });
+            .map(|(row, &i)| {
+                let i = i as usize;
+                let js = nl.of(row).iter().map(|&j| j as usize);
+                let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| vol[j]);
                 let det = match det {
                     Some(d) if d.penetration > 0.0 => d,
-                    _ => {
-                        *dl = Vector::zeros();
-                        *pen_prev = 0.0;
-                        return None;
-                    }
+                    _ => return Outcome::default(),
                 };
-                let pen_rate = (det.penetration - *pen_prev) / dt;
-                *pen_prev = det.penetration;
+                let mut dl = spring[i];
+                let pen_rate = (det.penetration - penetration[i]) / dt;
                 let j = det.nearest;
                 let vrel = p.vel[i] - p.vel[j];
                 let fr = det.repulsion;
@@ -109,28 +126,35 @@ pub(crate) fn contact(
                     _ => p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]),
                 };
                 let c_t = 2.0 * zeta * (k_f * m_eff).sqrt();
-                let ff = contact::friction(dl, vrel, det.normal, dt, k_f, c_t, mu, fr.norm());
+                let ff = contact::friction(&mut dl, vrel, det.normal, dt, k_f, c_t, mu, fr.norm());
                 let cdamp = 2.0 * zeta * (k_r * m_eff).sqrt();
                 let fd = det.normal * (cdamp * pen_rate);
                 let work = -fd.norm() * pen_rate.abs() * dt;
-                Some(Hit {
-                    force: fr + ff + fd,
-                    nearest: j,
-                    distance: det.distance,
-                    damping_work: work,
-                })
+                Outcome {
+                    spring: dl,
+                    penetration: det.penetration,
+                    hit: Some(Hit {
+                        force: fr + ff + fd,
+                        nearest: j,
+                        distance: det.distance,
+                        damping_work: work,
+                    }),
+                }
             })
             .collect();
         // Sequential gather: eq. 29 reactions and eq. 17 sums in particle order.
         let mut damp = 0.0;
         let mut through = None;
-        for (i, h) in hits.into_iter().enumerate() {
+        for (&i, o) in cl.particles.iter().zip(outcomes) {
+            let i = i as usize;
+            c.spring[i] = o.spring;
+            c.penetration[i] = o.penetration;
             let Some(Hit {
                 force: f,
                 nearest: j,
                 distance: dist,
                 damping_work: work,
-            }) = h
+            }) = o.hit
             else {
                 continue;
             };

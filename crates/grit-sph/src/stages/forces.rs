@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::{ParTasks, SphView, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{Matrix, Vector};
-use crate::neighbours::{Pair, PairCache};
+use crate::neighbours::{CachedPair, PairCache};
 use crate::particles::KINEMATIC;
 use crate::world::Settings;
 
@@ -17,10 +17,13 @@ struct ParticleForce {
 
 /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9, with the
 /// Shepard sums `sh`), the hourglass force (eq. 16, against the velocity gradients `gv`) and
-/// gravity, into `accel`; returns the hourglass work of the step (J/m).
+/// gravity, into `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes
+/// after the stress stage.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn forces(
     s: SphView<'_>,
     cache: &PairCache,
+    vol: &[f64],
     sh: &[f64],
     gv: &[Matrix],
     settings: &Settings,
@@ -31,7 +34,6 @@ pub(crate) fn forces(
     let alpha = settings.hourglass;
     let g = settings.gravity_m_s2;
     let h = k.h;
-    let radius = k.radius();
     // σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
     let sig: Vec<Matrix> = (0..p.len())
         .into_par_iter()
@@ -65,20 +67,29 @@ pub(crate) fn forces(
                 };
             }
             let vi = p.vel[i];
-            let voli = p.mass[i] / p.rho[i];
+            let voli = vol[i];
             let mut a = Vector::zeros();
             let mut fhg = Vector::zeros();
-            for &Pair { j, xij, r, w, dw } in cache.of(nl, i) {
+            for &CachedPair {
+                j,
+                xij,
+                e,
+                r,
+                w,
+                dw_r,
+                near_ref,
+            } in cache.of(nl, i)
+            {
                 if r == 0.0 {
                     continue;
                 }
-                let grad = xij * (dw / r);
+                let j = j as usize;
+                let grad = xij * dw_r;
                 a += (sig[i] + sig[j]) * grad * p.mass[j];
                 if alpha > 0.0 && w > 0.0 {
-                    let e = xij / r;
                     // Not the kernel sums' volume: the stress stage has moved ρ since (continuity), and
                     // both volumes must be the same step's for a symmetric pair force.
-                    let volj = p.mass[j] / p.rho[j];
+                    let volj = vol[j];
                     // Heavily sheared material can bring two particles almost on top of
                     // each other; 1/r² then makes the pair force stiff enough to blow the
                     // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
@@ -90,8 +101,8 @@ pub(crate) fn forces(
                     let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
                     let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
                     // Stiffness part: separation error against the mean deformation gradient.
-                    let xr = p.x_ref[i] - p.x_ref[j];
-                    let stiff = if xr.norm() < radius {
+                    let stiff = if near_ref {
+                        let xr = p.x_ref[i] - p.x_ref[j];
                         let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
                         c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
                     } else {

@@ -7,7 +7,6 @@ mod density_filter;
 mod forces;
 mod integrate;
 mod kernel_sums;
-mod rates;
 mod rigid;
 mod stress;
 mod time_step;
@@ -17,7 +16,6 @@ pub(crate) use density_filter::filter_density;
 pub(crate) use forces::forces;
 pub(crate) use integrate::{integrate, Blowup};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};
-pub(crate) use rates::velocity_gradients;
 pub(crate) use rigid::rigid;
 pub(crate) use stress::stress;
 pub(crate) use time_step::stable_dt;
@@ -61,6 +59,20 @@ pub(crate) trait ParTasks: IndexedParallelIterator {
 }
 
 impl<I: IndexedParallelIterator> ParTasks for I {}
+
+/// Particle volumes V_i = m_i/ρ_i into `out`, taken once per particle so that no sum over pairs
+/// divides for its neighbour's volume.
+pub(crate) fn volumes(p: &Particles, out: &mut Vec<f64>) {
+    use rayon::prelude::*;
+    out.clear();
+    out.par_extend(
+        p.mass
+            .par_iter()
+            .zip(&p.rho)
+            .par_tasks()
+            .map(|(m, r)| m / r),
+    );
+}
 
 /// Per-body constants the stages need, looked up by particle.
 #[derive(Debug, Clone, Copy, Default)]

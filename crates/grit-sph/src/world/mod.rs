@@ -19,8 +19,8 @@ use crate::body::Body;
 use crate::contact::{ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::kernel::Kernel;
-use crate::math::{Matrix, Vector};
-use crate::neighbours::{self, NeighbourLists, PairCache};
+use crate::math::Vector;
+use crate::neighbours::{self, PairCache, WorldLists};
 use crate::particles::Particles;
 use crate::stages::{self, Blowup, BodyConst, KernelSums, PassedThrough, SphView};
 use crate::timers::{Stage, Timers};
@@ -30,10 +30,11 @@ use crate::timers::{Stage, Timers};
 struct Scratch {
     /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
     pairs: PairCache,
-    /// Volumes, Shepard sums and correction matrices of the kernel sums.
+    /// Volumes, Shepard sums, correction matrices and velocity gradients of the kernel sums.
     sums: KernelSums,
-    /// Velocity gradients of the rates.
-    gradv: Vec<Matrix>,
+    /// Particle volumes after the stress stage: read by the forces, the contact and the density
+    /// filter, which all run before ρ changes again.
+    vol: Vec<f64>,
     /// Accelerations of the forces.
     acc: Vec<Vector>,
     /// Contact force on each particle.
@@ -56,7 +57,7 @@ pub struct World {
     /// Positions at the last neighbour build.
     x_build: Vec<Vector>,
     #[serde(skip)]
-    nbrs: NeighbourLists,
+    nbrs: WorldLists,
     #[serde(skip)]
     nbrs_valid: bool,
     #[serde(skip)]
@@ -82,7 +83,7 @@ impl World {
             next_id: 0,
             work: NumericalWork::default(),
             x_build: Vec::new(),
-            nbrs: NeighbourLists::default(),
+            nbrs: WorldLists::default(),
             nbrs_valid: false,
             scratch: Scratch::default(),
             timers: Timers::default(),
@@ -170,8 +171,13 @@ impl World {
             }
         }
         let radius = self.neighbour_reach();
-        self.nbrs =
-            neighbours::build_for_bodies(&self.particles, &self.bodies, &self.contacts, radius);
+        self.nbrs = neighbours::build_for_bodies(
+            &self.particles,
+            &self.bodies,
+            &self.contacts,
+            radius,
+            self.kernel.radius(),
+        );
         self.x_build = self.particles.pos.clone();
         self.nbrs_valid = true;
     }
@@ -229,8 +235,8 @@ impl World {
         if self.needs_rebuild() {
             timers.time(Stage::Neighbours, || self.rebuild_neighbours());
         }
+        // The rates are summed in the kernel sums' pass; their timer stays at zero in a step.
         timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
-        timers.time(Stage::Rates, || self.rates(&bc));
         timers.time(Stage::Stress, || self.stress(&bc, dt));
         timers.time(Stage::Forces, || self.forces(&bc, dt));
         let contact = timers.time(Stage::Contact, || self.contact(&bc, dt));
@@ -262,15 +268,15 @@ impl World {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
             self.rebuild_neighbours();
             self.kernel_sums(&bc);
-            self.rates(&bc);
         }
         match stage {
             Stage::Neighbours => self.rebuild_neighbours(),
-            Stage::KernelSums => self.kernel_sums(&bc),
-            Stage::Rates => self.rates(&bc),
+            // The rates are summed in the kernel sums' pass.
+            Stage::KernelSums | Stage::Rates => self.kernel_sums(&bc),
             Stage::Stress => self.stress(&bc, dt),
             Stage::Forces => self.forces(&bc, dt),
             Stage::Contact => {
+                stages::volumes(&self.particles, &mut self.scratch.vol);
                 // A surface particle passing through is a result of the state, not of timing.
                 let _ = self.contact(&bc, dt);
             }
@@ -329,11 +335,13 @@ impl World {
 
     fn filter_density_with(&mut self, bc: &[BodyConst]) {
         let before = self.energy().elastic;
-        if !self.nbrs_valid || self.nbrs.start.len() != self.particles.len() + 1 {
+        if !self.nbrs_valid || self.nbrs.same.start.len() != self.particles.len() + 1 {
             self.rebuild_neighbours();
         }
+        stages::volumes(&self.particles, &mut self.scratch.vol);
         let s = self.sph(bc);
-        self.particles.rho = stages::filter_density(s, self.settings.density_filter);
+        let vol = &self.scratch.vol;
+        self.particles.rho = stages::filter_density(s, vol, self.settings.density_filter);
         self.work.density_filter += self.energy().elastic - before;
     }
 
@@ -344,7 +352,7 @@ impl World {
     fn sph<'a>(&'a self, bc: &'a [BodyConst]) -> SphView<'a> {
         SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         }
@@ -353,17 +361,11 @@ impl World {
     fn kernel_sums(&mut self, bc: &[BodyConst]) {
         let s = SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         };
         stages::kernel_sums(s, &mut self.scratch.pairs, &mut self.scratch.sums);
-    }
-
-    fn rates(&mut self, bc: &[BodyConst]) {
-        let gradv =
-            stages::velocity_gradients(self.sph(bc), &self.scratch.pairs, &self.scratch.sums);
-        self.scratch.gradv = gradv;
     }
 
     fn stress(&mut self, bc: &[BodyConst], dt: f64) {
@@ -372,7 +374,7 @@ impl World {
             &mut self.particles,
             &self.bodies,
             bc,
-            &self.scratch.gradv,
+            &self.scratch.sums.gradv,
             beta,
             dt,
         );
@@ -382,16 +384,18 @@ impl World {
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
         let s = SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         };
         let sc = &mut self.scratch;
+        stages::volumes(s.p, &mut sc.vol);
         let hg = stages::forces(
             s,
             &sc.pairs,
+            &sc.vol,
             &sc.sums.shepard,
-            &sc.gradv,
+            &sc.sums.gradv,
             &self.settings,
             dt,
             &mut sc.acc,
@@ -402,12 +406,14 @@ impl World {
     fn contact(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
         let s = SphView {
             p: &self.particles,
-            nl: &self.nbrs,
+            nl: &self.nbrs.same,
             k: &self.kernel,
             bc,
         };
         let through = stages::contact(
             s,
+            &mut self.nbrs.contact,
+            &self.scratch.vol,
             self.settings.spacing_m,
             dt,
             &mut self.contacts,
