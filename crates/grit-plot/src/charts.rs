@@ -367,11 +367,20 @@ pub fn mass_loss(
 
 // ----------------------------------------------- one sample at every angle (Fig. 9)
 
+/// One sample's mass-loss curve in a cell of the Fig. 9 chart.
+struct AngleCurve {
+    angle_deg: f64,
+    /// Cumulative (grain g/m, loss mg/m).
+    points: Vec<(f64, f64)>,
+    /// The cell's steady state; `None` when not checked.
+    steady: Option<bool>,
+}
+
 struct SampleAngles {
     label: String,
     sample: u32,
-    /// (angle, cumulative (grain g/m, loss mg/m), the cell's steady state), by angle.
-    curves: Vec<(f64, Vec<(f64, f64)>, Option<bool>)>,
+    /// One curve per angle, by angle.
+    curves: Vec<AngleCurve>,
     window: usize,
     notes: Vec<String>,
 }
@@ -379,7 +388,7 @@ struct SampleAngles {
 impl Figure for SampleAngles {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let area = with_notes(root, &self.notes)?;
-        let all = || self.curves.iter().flat_map(|c| c.1.iter().copied());
+        let all = || self.curves.iter().flat_map(|c| c.points.iter().copied());
         let xmax = top(all().map(|p| p.0));
         let ymax = top(all().map(|p| p.1));
         let caption = format!(
@@ -387,7 +396,8 @@ impl Figure for SampleAngles {
             self.label, self.sample
         );
         let mut chart = mass_axes(&area, caption, xmax, ymax)?;
-        for (i, (angle, pts, steady)) in self.curves.iter().enumerate() {
+        for (i, curve) in self.curves.iter().enumerate() {
+            let (angle, pts) = (curve.angle_deg, &curve.points);
             let line = colour(i).stroke_width(2);
             chart
                 .draw_series(LineSeries::new(pts.iter().copied(), line))
@@ -395,7 +405,7 @@ impl Figure for SampleAngles {
                 .label(format!("{angle}°"))
                 .legend(line_key(line));
             if pts.len() >= self.window && self.window >= 2 {
-                let marks = marker_style(colour(i), *steady);
+                let marks = marker_style(colour(i), curve.steady);
                 chart
                     .draw_series(
                         pts[pts.len() - self.window..]
@@ -405,7 +415,10 @@ impl Figure for SampleAngles {
                     .map_err(de)?;
             }
         }
-        hollow_key(&mut chart, any_unsteady(self.curves.iter().map(|c| c.2)))?;
+        hollow_key(
+            &mut chart,
+            any_unsteady(self.curves.iter().map(|c| c.steady)),
+        )?;
         legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
     }
 }
@@ -446,24 +459,27 @@ pub fn sample_by_angle(
             raw.iter().filter(in_series).map(|r| r.sample).collect();
         let mut drawn = 0;
         for &k in numbers.iter().take(SAMPLES_BY_ANGLE) {
-            let mut curves: Vec<(f64, Vec<(f64, f64)>, Option<bool>)> = raw
+            let mut curves: Vec<AngleCurve> = raw
                 .iter()
                 .filter(in_series)
                 .filter(|r| r.sample == k)
                 .map(|r| {
                     let c = &cells[r.cell as usize];
-                    let steady = c.steady_state.as_ref().map(|s| s.steady);
-                    (c.angle_deg, sample_curve(r), steady)
+                    AngleCurve {
+                        angle_deg: c.angle_deg,
+                        points: sample_curve(r),
+                        steady: c.steady_state.as_ref().map(|s| s.steady),
+                    }
                 })
                 .collect();
             if curves.len() < 2 {
                 continue;
             }
-            curves.sort_by(|a, b| a.0.total_cmp(&b.0));
+            curves.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
             let mut notes = vec![format!(
                 "Dots: the last {window} impacts, whose slope is the sample's erosion."
             )];
-            notes.extend(steady_notes(curves.iter().map(|c| c.2)));
+            notes.extend(steady_notes(curves.iter().map(|c| c.steady)));
             let fig = SampleAngles {
                 label: label.clone(),
                 sample: k,
