@@ -258,6 +258,7 @@ async fn stale_worker_gets_409_and_changes_nothing() {
     let done = grit_farm::api::CompleteRequest {
         lease_id: job.lease_id,
         impacts: vec![record],
+        checkpoint: None,
     };
     let e = stale.complete(job.job_id, &done).await.unwrap_err();
     assert_eq!(e.status().map(|s| s.as_u16()), Some(409), "{e}");

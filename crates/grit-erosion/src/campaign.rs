@@ -39,7 +39,7 @@ use crate::shapes::Shape;
 mod json;
 mod plan;
 use json::{field_path, one_or_many, reject_unknown};
-pub use plan::{ImpactPlan, Samples, TargetSem, UntilSteady};
+pub use plan::{annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady};
 
 /// Fewest impacts a sample may be planned with: the slope window (20) plus one.
 pub const MIN_IMPACTS: u32 = 21;

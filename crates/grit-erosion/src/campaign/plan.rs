@@ -9,6 +9,7 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::json::count;
+use crate::aggregate::CellResult;
 use super::{err, SpecError};
 
 /// Grow every sample of a cell by `step` impacts until the cell is steady or reaches `max`.
@@ -250,6 +251,77 @@ impl<'de> Deserialize<'de> for Samples {
             }
         }
         d.deserialize_any(SamplesVisitor)
+    }
+}
+
+/// What the coordinator does with a cell once every sample has its planned impacts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NextStep {
+    /// Plan every sample of the cell for this many impacts and run them on.
+    ExtendImpacts(u32),
+    /// Add samples until the cell has this many.
+    AddSamples(u32),
+    /// The cell is finished.
+    Final,
+}
+
+/// Standard error of the cell's erosion over its |mean|: 0 when every slope is equal,
+/// infinite for a zero mean with scatter, `None` below two slopes.
+pub fn sem_rel(cell: &CellResult) -> Option<f64> {
+    let (mean, sem) = (cell.erosion_mean?, cell.erosion_sem?);
+    Some(if sem == 0.0 {
+        0.0
+    } else if mean == 0.0 {
+        f64::INFINITY
+    } else {
+        sem / mean.abs()
+    })
+}
+
+/// The next step for a finished cell (`docs/erosion.md`, "Extending a cell"). Impacts come
+/// first: while the steady-state check fails and `max` is not reached, every sample grows by
+/// `step`. Then, while `sem/|mean| > target_sem_rel` and samples are below `max`, the cell
+/// grows to `n·(rel/target)²` samples, the count at which the error bar would meet the
+/// target if the scatter stayed as measured, at least one more and at most `max`.
+pub fn next_step(
+    cell: &CellResult,
+    until: Option<UntilSteady>,
+    target: Option<TargetSem>,
+) -> NextStep {
+    if let Some(u) = until {
+        let steady = cell.steady_state.as_ref().is_some_and(|s| s.steady);
+        let planned = cell.impacts_planned as u32;
+        if !steady && planned < u.max {
+            return NextStep::ExtendImpacts(planned.saturating_add(u.step).min(u.max));
+        }
+    }
+    if let Some(t) = target {
+        let n = cell.samples_planned as u32;
+        let rel = sem_rel(cell);
+        if n < t.max && rel.is_none_or(|r| r > t.target_sem_rel) {
+            let wanted = match rel {
+                Some(r) if r.is_finite() => {
+                    (n as f64 * (r / t.target_sem_rel).powi(2)).ceil().min(t.max as f64) as u32
+                }
+                Some(_) => t.max,
+                None => n + 1,
+            };
+            return NextStep::AddSamples(wanted.clamp(n + 1, t.max));
+        }
+    }
+    NextStep::Final
+}
+
+/// Marks what the rules reached: the error bar reached under `target`, and a cell left
+/// unsteady at its `max` impacts says so first in its steady-state reason.
+pub fn annotate(cell: &mut CellResult, until: Option<UntilSteady>, target: Option<TargetSem>) {
+    if target.is_some() {
+        cell.erosion_sem_rel = sem_rel(cell);
+    }
+    if let (Some(u), Some(s)) = (until, cell.steady_state.as_mut()) {
+        if !s.steady && !cell.partial && cell.impacts_planned as u32 >= u.max {
+            s.reason = format!("reached max {} impacts; {}", u.max, s.reason);
+        }
     }
 }
 

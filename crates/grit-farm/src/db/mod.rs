@@ -17,11 +17,14 @@ use uuid::Uuid;
 use crate::error::{Error, Result};
 
 mod campaigns;
+mod extend;
 mod worker;
 mod workers;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod extend_tests;
 
 /// Current time in Unix milliseconds.
 pub fn now_ms() -> i64 {
