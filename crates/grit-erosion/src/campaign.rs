@@ -39,7 +39,9 @@ use crate::shapes::Shape;
 mod json;
 mod plan;
 use json::{field_path, one_or_many, reject_unknown};
-pub use plan::{annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady};
+pub use plan::{
+    annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
+};
 
 /// Fewest impacts a sample may be planned with: the slope window (20) plus one.
 pub const MIN_IMPACTS: u32 = 21;
@@ -126,7 +128,10 @@ impl Default for Impacts {
     /// The seed paper: 140 at 15°, 70 at 30°, 60 at every other angle.
     fn default() -> Self {
         Impacts::PerAngle {
-            angles: vec![(15.0, ImpactPlan::Fixed(140)), (30.0, ImpactPlan::Fixed(70))],
+            angles: vec![
+                (15.0, ImpactPlan::Fixed(140)),
+                (30.0, ImpactPlan::Fixed(70)),
+            ],
             default: Some(ImpactPlan::Fixed(60)),
         }
     }
@@ -157,7 +162,8 @@ impl Serialize for Impacts {
         match self {
             Impacts::All(n) => n.serialize(s),
             Impacts::PerAngle { angles, default } => {
-                let value = |p: &ImpactPlan| serde_json::to_value(p).map_err(serde::ser::Error::custom);
+                let value =
+                    |p: &ImpactPlan| serde_json::to_value(p).map_err(serde::ser::Error::custom);
                 let mut m = Map::new();
                 for (a, n) in angles {
                     m.insert(format!("{a}"), value(n)?);

@@ -9,8 +9,8 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::json::count;
-use crate::aggregate::CellResult;
 use super::{err, SpecError};
+use crate::aggregate::CellResult;
 
 /// Grow every sample of a cell by `step` impacts until the cell is steady or reaches `max`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -300,9 +300,9 @@ pub fn next_step(
         let rel = sem_rel(cell);
         if n < t.max && rel.is_none_or(|r| r > t.target_sem_rel) {
             let wanted = match rel {
-                Some(r) if r.is_finite() => {
-                    (n as f64 * (r / t.target_sem_rel).powi(2)).ceil().min(t.max as f64) as u32
-                }
+                Some(r) if r.is_finite() => (n as f64 * (r / t.target_sem_rel).powi(2))
+                    .ceil()
+                    .min(t.max as f64) as u32,
                 Some(_) => t.max,
                 None => n + 1,
             };
@@ -375,10 +375,9 @@ mod tests {
 
     #[test]
     fn target_sem_parses() {
-        let s = CampaignSpec::from_json(
-            r#"{"samples": {"target_sem_rel": 0.1, "min": 3, "max": 40}}"#,
-        )
-        .unwrap();
+        let s =
+            CampaignSpec::from_json(r#"{"samples": {"target_sem_rel": 0.1, "min": 3, "max": 40}}"#)
+                .unwrap();
         s.validate().unwrap();
         assert_eq!(s.samples.initial(), 3);
         assert_eq!(s.samples.max(), 40);
@@ -411,7 +410,9 @@ mod tests {
             "impacts.until_steady.x"
         );
         assert_eq!(
-            field_of(r#"{"impacts": {"15": {"until_steady": {"min": 21, "max": 30, "step": 0}}, "default": 60}}"#),
+            field_of(
+                r#"{"impacts": {"15": {"until_steady": {"min": 21, "max": 30, "step": 0}}, "default": 60}}"#
+            ),
             "impacts[\"15\"].until_steady.step"
         );
         assert_eq!(

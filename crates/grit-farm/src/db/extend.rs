@@ -6,9 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{
-    job_seed, next_step, CampaignSpec, NextStep, TargetSem, UntilSteady,
-};
+use grit_erosion::campaign::{job_seed, next_step, CampaignSpec, NextStep, TargetSem, UntilSteady};
 use grit_erosion::{aggregate_cell, CellInput, Impact, SampleInput, SLOPE_WINDOW};
 use sqlx::{QueryBuilder, Row, Sqlite, Transaction};
 use uuid::Uuid;
@@ -70,7 +68,8 @@ impl CellPlan {
     }
 }
 
-const PLAN_COLUMNS: &str = "impacts, samples, impacts_max, impacts_step, samples_max, target_sem_rel";
+const PLAN_COLUMNS: &str =
+    "impacts, samples, impacts_max, impacts_step, samples_max, target_sem_rel";
 
 impl Store {
     /// Every cell's current plan, in cell order.
@@ -184,7 +183,12 @@ pub(super) async fn settle_cell(
                 .bind(cell)
                 .execute(&mut **tx)
                 .await?;
-            grow_total(tx, campaign, (to - plan.impacts) as i64 * plan.samples as i64).await?;
+            grow_total(
+                tx,
+                campaign,
+                (to - plan.impacts) as i64 * plan.samples as i64,
+            )
+            .await?;
         }
         NextStep::AddSamples(to) => {
             let r = sqlx::query("SELECT rowid, spec FROM campaigns WHERE id = ?")
@@ -216,7 +220,12 @@ pub(super) async fn settle_cell(
                 .bind(cell)
                 .execute(&mut **tx)
                 .await?;
-            grow_total(tx, campaign, (to - plan.samples) as i64 * plan.impacts as i64).await?;
+            grow_total(
+                tx,
+                campaign,
+                (to - plan.samples) as i64 * plan.impacts as i64,
+            )
+            .await?;
         }
         NextStep::Final => {}
     }

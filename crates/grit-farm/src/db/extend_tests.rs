@@ -96,7 +96,10 @@ async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
     // The last job of the cell done: every sample is planned for 24 and queued again.
     let st = s.status(id).await.unwrap();
     assert_eq!(st.state, CampaignState::Running);
-    assert_eq!((st.jobs.queued, st.impacts_total, st.impacts_done), (2, 48, 42));
+    assert_eq!(
+        (st.jobs.queued, st.impacts_total, st.impacts_done),
+        (2, 48, 42)
+    );
     assert_eq!(st.cells[0].impacts_total, 48);
     let b = run_one(&s, |_, _| 0.0).await;
     assert_eq!((b.impacts_done, b.impacts_planned), (21, 24));
@@ -118,7 +121,11 @@ async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
     assert!(!cell.partial);
     let ss = cell.steady_state.as_ref().unwrap();
     assert!(!ss.steady);
-    assert!(ss.reason.starts_with("reached max 25 impacts; "), "{}", ss.reason);
+    assert!(
+        ss.reason.starts_with("reached max 25 impacts; "),
+        "{}",
+        ss.reason
+    );
     assert_eq!(r.steady, Some(false));
 }
 
@@ -155,7 +162,11 @@ async fn samples_are_added_until_the_error_bar_or_max() {
     assert!(!a.extendable);
     run_one(&s, rate).await;
     let st = s.status(id).await.unwrap();
-    assert_eq!((st.jobs.done, st.jobs.queued), (2, 3), "grown straight to max");
+    assert_eq!(
+        (st.jobs.done, st.jobs.queued),
+        (2, 3),
+        "grown straight to max"
+    );
     assert_eq!(st.impacts_total, 5 * 21);
     assert_eq!(st.cells[0].samples_total, 5);
     let mut seen = Vec::new();
@@ -171,7 +182,9 @@ async fn samples_are_added_until_the_error_bar_or_max() {
     let r = s.results(id, false).await.unwrap().results;
     let cell = &r.cells[0];
     assert_eq!((cell.samples, cell.samples_planned), (5, 5));
-    let rel = cell.erosion_sem_rel.expect("reported for a target_sem cell");
+    let rel = cell
+        .erosion_sem_rel
+        .expect("reported for a target_sem cell");
     assert!(rel > 0.01, "stopped at max above the target: {rel}");
 }
 

@@ -22,9 +22,9 @@ mod worker;
 mod workers;
 
 #[cfg(test)]
-mod tests;
-#[cfg(test)]
 mod extend_tests;
+#[cfg(test)]
+mod tests;
 
 /// Current time in Unix milliseconds.
 pub fn now_ms() -> i64 {
