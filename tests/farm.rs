@@ -285,6 +285,7 @@ async fn stale_worker_gets_409_and_changes_nothing() {
     let done = grit_farm::api::CompleteRequest {
         lease_id: job.lease_id,
         impacts: vec![record],
+        checkpoint: None,
     };
     let e = stale.complete(job.job_id, &done).await.unwrap_err();
     assert_eq!(e.status().map(|s| s.as_u16()), Some(409), "{e}");
@@ -527,4 +528,63 @@ async fn sigterm_releases_the_job_with_a_checkpoint_and_exits_0() {
         .unwrap();
     assert!(job.checkpoint.is_some());
     assert_eq!(job.impacts_done, s.impacts_done as u32);
+}
+
+/// An until-steady campaign: the coarse scene erodes nothing in 25 impacts, so every sample
+/// grows 21 → 23 → 25 and the cell ends at `max`, flagged unsteady.
+fn until_steady_campaign() -> String {
+    common::campaign("grow", "[60]", 2, 21).replace(
+        r#""impacts": 21"#,
+        r#""impacts": {"until_steady": {"min": 21, "max": 25, "step": 2}}"#,
+    )
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn until_steady_extends_samples_bit_for_bit() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = until_steady_campaign();
+    assert!(spec.contains("until_steady"));
+    let local_results = grit_run(dir.path(), &spec, "local", true);
+    let cell = &local_results["cells"][0];
+    assert_eq!(cell["impacts_planned"], 25, "grown to max");
+    let reason = cell["steady_state"]["reason"].as_str().unwrap();
+    assert!(
+        cell["steady_state"]["steady"] == true || reason.starts_with("reached max 25 impacts"),
+        "{reason}"
+    );
+    let local = raw_series(&local_results);
+    assert!(local.iter().all(|(_, _, r)| r.len() == 25));
+
+    // The first 21 impacts equal those of samples planned with 21 from the start.
+    let fixed = raw_series(&grit_run(dir.path(), &campaign(2, 21), "fixed", true));
+    let head: Vec<_> = local
+        .iter()
+        .map(|(c, s, r)| (*c, *s, r[..21].to_vec()))
+        .collect();
+    assert_bitwise_equal(&head, &fixed);
+
+    // Served, two workers, one killed with -9 while the cell grows: the same records.
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 2.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let mut w1 = worker(dir.path(), &coord.url, "w1");
+    let _w2 = worker(dir.path(), &coord.url, "w2");
+    let grown = wait_for(
+        Duration::from_secs(120),
+        "the first extension",
+        || c.status(id),
+        |s| s.impacts_total > 42 && s.impacts_done >= 43,
+    )
+    .await;
+    assert!(grown.impacts_done < 50, "killed while the cell grows");
+    w1.kill9();
+    let s = wait_done(&c, id, Duration::from_secs(120)).await;
+    assert_eq!((s.impacts_done, s.impacts_total), (50, 50));
+    let farm_results = c.results_value(id, true).await.unwrap();
+    assert_eq!(
+        farm_results["cells"][0]["steady_state"],
+        cell["steady_state"]
+    );
+    assert_bitwise_equal(&raw_series(&farm_results), &local);
 }

@@ -171,6 +171,8 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let outcome = embedded::run(&spec, &opts, stop, |event| match event {
         RunEvent::Started { impacts_total } => bar.set_length(impacts_total),
         RunEvent::Status(status) => {
+            // Cells that grow (until_steady, target_sem_rel) raise the total.
+            bar.set_length(status.impacts_total);
             bar.set_position(status.impacts_done);
             bar.set_message(run_message(status));
             if plain && last_line.is_none_or(|t| t.elapsed() >= Duration::from_secs(30)) {
@@ -388,6 +390,7 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
             cells.push(multi.add(progress::bar(c.impacts_total, &prefix, true)));
         }
         for (bar, c) in cells.iter().zip(&s.cells) {
+            bar.set_length(c.impacts_total);
             bar.set_position(c.impacts_done);
             bar.set_message(format!("{}/{} samples", c.samples_done, c.samples_total));
         }

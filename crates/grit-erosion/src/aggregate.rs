@@ -137,6 +137,10 @@ pub struct CellResult {
     pub erosion_std: Option<f64>,
     /// Standard error of the mean, std/√n; `null` below 2 samples.
     pub erosion_sem: Option<f64>,
+    /// Standard error over |mean| reached, for a cell whose samples grow until it is small
+    /// (`samples.target_sem_rel` of the campaign spec); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub erosion_sem_rel: Option<f64>,
     /// Each reported sample's erosion, by sample index.
     pub per_sample: Vec<SampleResult>,
     /// Mean cumulative mass loss against grain mass (Fig. 10b).
@@ -482,6 +486,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         erosion_mean: summary.map(|s| s.mean),
         erosion_std: summary.and_then(|s| s.std),
         erosion_sem: summary.and_then(|s| s.sem),
+        erosion_sem_rel: None,
         per_sample,
         mean_series,
         convergence: convergence(&slopes),

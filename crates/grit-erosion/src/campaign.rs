@@ -37,7 +37,11 @@ use crate::impact::ImpactParams;
 use crate::shapes::Shape;
 
 mod json;
-use json::{count, field_path, one_or_many, reject_unknown};
+mod plan;
+use json::{field_path, one_or_many, reject_unknown};
+pub use plan::{
+    annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
+};
 
 /// Fewest impacts a sample may be planned with: the slope window (20) plus one.
 pub const MIN_IMPACTS: u32 = 21;
@@ -105,17 +109,18 @@ impl Serialize for MaterialSpec {
     }
 }
 
-/// Impacts per sample: one number for every angle, or per angle with a `default`.
+/// Impacts per sample: one plan for every angle, or per angle with a `default`; each plan a
+/// number or `{"until_steady": {...}}` ([`ImpactPlan`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Impacts {
-    /// The same number at every angle.
-    All(u32),
+    /// The same plan at every angle.
+    All(ImpactPlan),
     /// Per angle (keys are angles in degrees), with a default for angles not listed.
     PerAngle {
-        /// (angle in degrees, impacts), in the order given.
-        angles: Vec<(f64, u32)>,
-        /// Impacts at angles not listed; `None` requires every angle to be listed.
-        default: Option<u32>,
+        /// (angle in degrees, plan), in the order given.
+        angles: Vec<(f64, ImpactPlan)>,
+        /// The plan at angles not listed; `None` requires every angle to be listed.
+        default: Option<ImpactPlan>,
     },
 }
 
@@ -123,15 +128,24 @@ impl Default for Impacts {
     /// The seed paper: 140 at 15°, 70 at 30°, 60 at every other angle.
     fn default() -> Self {
         Impacts::PerAngle {
-            angles: vec![(15.0, 140), (30.0, 70)],
-            default: Some(60),
+            angles: vec![
+                (15.0, ImpactPlan::Fixed(140)),
+                (30.0, ImpactPlan::Fixed(70)),
+            ],
+            default: Some(ImpactPlan::Fixed(60)),
         }
     }
 }
 
 impl Impacts {
-    /// Impacts planned at `angle_deg`, or `None` when the map has neither it nor a default.
+    /// Impacts first planned at `angle_deg` (an until-steady plan's `min`), or `None` when
+    /// the map has neither it nor a default.
     pub fn at(&self, angle_deg: f64) -> Option<u32> {
+        self.plan_at(angle_deg).map(|p| p.initial())
+    }
+
+    /// The plan at `angle_deg`, or `None` when the map has neither it nor a default.
+    pub fn plan_at(&self, angle_deg: f64) -> Option<ImpactPlan> {
         match self {
             Impacts::All(n) => Some(*n),
             Impacts::PerAngle { angles, default } => angles
@@ -146,14 +160,16 @@ impl Impacts {
 impl Serialize for Impacts {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
-            Impacts::All(n) => s.serialize_u32(*n),
+            Impacts::All(n) => n.serialize(s),
             Impacts::PerAngle { angles, default } => {
+                let value =
+                    |p: &ImpactPlan| serde_json::to_value(p).map_err(serde::ser::Error::custom);
                 let mut m = Map::new();
                 for (a, n) in angles {
-                    m.insert(format!("{a}"), Value::from(*n));
+                    m.insert(format!("{a}"), value(n)?);
                 }
                 if let Some(d) = default {
-                    m.insert("default".into(), Value::from(*d));
+                    m.insert("default".into(), value(d)?);
                 }
                 m.serialize(s)
             }
@@ -205,9 +221,8 @@ pub struct CampaignSpec {
     /// Grain shapes: built-in names or `{name, vertices_m}` polygons; one or an array.
     #[serde(deserialize_with = "one_or_many")]
     pub shapes: Vec<Shape>,
-    /// Samples per cell.
-    #[serde(deserialize_with = "count")]
-    pub samples: u32,
+    /// Samples per cell: a number, or `{"target_sem_rel", "min", "max"}` ([`Samples`]).
+    pub samples: Samples,
     /// Impacts per sample, per angle.
     pub impacts: Impacts,
     /// Impact speed V in m/s; sweepable.
@@ -242,7 +257,7 @@ impl Default for CampaignSpec {
             seed: 0,
             angles_deg: vec![15.0, 30.0, 45.0, 60.0, 75.0, 90.0],
             shapes: Shape::paper().to_vec(),
-            samples: 25,
+            samples: Samples::Fixed(25),
             impacts: Impacts::default(),
             velocity_m_s: Sweep::one(p.velocity_m_s),
             grain: GrainSpec::default(),
@@ -265,8 +280,10 @@ pub struct Cell {
     pub index: u32,
     /// The impact scene.
     pub params: ImpactParams,
-    /// Impacts each sample of this cell is planned to receive.
+    /// Impacts each sample of this cell is first planned to receive.
     pub impacts: u32,
+    /// The rule extending the impacts until the cell is steady, if the spec gives one.
+    pub until_steady: Option<UntilSteady>,
     /// Values of the swept dimensions other than angle and shape, by name with unit; a swept
     /// material appears as `material_index` (its position in the spec's `material` list).
     pub swept: BTreeMap<String, f64>,
@@ -373,9 +390,7 @@ impl CampaignSpec {
                 ));
             }
         }
-        if self.samples == 0 {
-            return Err(err("samples", "must be at least 1"));
-        }
+        self.samples.validate()?;
         if let Impacts::PerAngle { angles, .. } = &self.impacts {
             for (a, _) in angles {
                 if !(*a > 0.0 && *a <= 90.0) {
@@ -401,14 +416,15 @@ impl CampaignSpec {
                     }
                 }
             };
-            match self.impacts.at(*a) {
+            match self.impacts.plan_at(*a) {
+                Some(ImpactPlan::UntilSteady(u)) => u.validate(&field, min)?,
                 None => {
                     return Err(err(
                         "impacts",
                         format!("no entry for angle {a} and no \"default\""),
                     ))
                 }
-                Some(n) if n < min => {
+                Some(ImpactPlan::Fixed(n)) if n < min => {
                     return Err(err(
                         field,
                         if self.allow_short_samples {
@@ -456,7 +472,7 @@ impl CampaignSpec {
         if self.material.values().is_empty() {
             return Err(err("material", "must give at least one material"));
         }
-        let jobs = self.cell_count() as u128 * self.samples as u128;
+        let jobs = self.cell_count() as u128 * self.samples.max() as u128;
         if jobs > MAX_JOBS as u128 {
             return Err(err(
                 "samples",
@@ -539,9 +555,11 @@ impl CampaignSpec {
                         swept.insert(name.to_string(), value);
                     }
                 }
+                let plan = self.impacts.plan_at(angle);
                 Cell {
                     index,
-                    impacts: self.impacts.at(angle).unwrap_or(0),
+                    impacts: plan.map_or(0, |p| p.initial()),
+                    until_steady: plan.and_then(|p| p.until_steady()),
                     params,
                     swept,
                 }
@@ -558,9 +576,10 @@ impl CampaignSpec {
     /// Every job, cell by cell and sample by sample, each with its own seed; validates first.
     pub fn expand(&self) -> Result<Vec<JobSpec>, SpecError> {
         let cells = self.cells()?;
-        let mut jobs = Vec::with_capacity(cells.len() * self.samples as usize);
+        let samples = self.samples.initial();
+        let mut jobs = Vec::with_capacity(cells.len() * samples as usize);
         for cell in &cells {
-            for sample in 0..self.samples {
+            for sample in 0..samples {
                 jobs.push(JobSpec {
                     cell: cell.index,
                     sample,
@@ -573,12 +592,12 @@ impl CampaignSpec {
         Ok(jobs)
     }
 
-    /// Total impacts the campaign plans (for progress and ETA).
+    /// Total impacts the campaign first plans (for progress and ETA); extended cells raise it.
     pub fn impacts_total(&self) -> Result<u64, SpecError> {
         Ok(self
             .cells()?
             .iter()
-            .map(|c| c.impacts as u64 * self.samples as u64)
+            .map(|c| c.impacts as u64 * self.samples.initial() as u64)
             .sum())
     }
 }
@@ -626,7 +645,7 @@ mod tests {
                 Shape::Rectangle
             ]
         );
-        assert_eq!(s.samples, 25);
+        assert_eq!(s.samples, Samples::Fixed(25));
         assert_eq!(s.impacts.at(15.0), Some(140));
         assert_eq!(s.impacts.at(30.0), Some(70));
         for a in [45.0, 60.0, 75.0, 90.0] {
@@ -828,7 +847,7 @@ mod tests {
             .unwrap();
         let cells = s.cells().unwrap();
         assert_eq!(cells.len(), 2);
-        let input = cells[1].input(s.samples, vec![]);
+        let input = cells[1].input(s.samples.initial(), vec![]);
         assert_eq!(input.angle_deg, 45.0);
         assert_eq!(input.shape, "hexagon");
         assert_eq!(input.swept.get("velocity_m_s"), Some(&100.0));

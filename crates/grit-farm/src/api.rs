@@ -341,6 +341,10 @@ pub struct ClaimedJob {
     /// The impact scene.
     #[schema(value_type = Object)]
     pub params: ImpactParams,
+    /// Whether the job's cell may later ask for more impacts (`until_steady`): then send a
+    /// checkpoint after the last impact with `complete`, so the job can resume from it.
+    #[serde(default)]
+    pub extendable: bool,
     /// The latest checkpoint, if any.
     pub checkpoint: Option<Checkpoint>,
 }
@@ -380,6 +384,10 @@ pub struct CompleteRequest {
     #[serde(default)]
     #[schema(value_type = Vec<Object>)]
     pub impacts: Vec<ImpactRecord>,
+    /// The state after the last impact, for a job claimed `extendable`; kept until its cell
+    /// is final.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub checkpoint: Option<Checkpoint>,
 }
 
 /// Failure report.

@@ -189,6 +189,7 @@ async fn client_loop(
                 &CompleteRequest {
                     lease_id: job.lease_id,
                     impacts: vec![record],
+                    checkpoint: None,
                 },
             )
             .await?;

@@ -312,7 +312,8 @@ impl Runner {
                 Err(None) => {}
             }
         }
-        self.complete(&job, pending).await
+        let last = job.extendable.then(|| encode(&sample));
+        self.complete(&job, pending, last).await
     }
 
     /// Sends the pending impacts; clears them once acknowledged. `Err(Some)` means the lease
@@ -366,10 +367,16 @@ impl Runner {
         }
     }
 
-    async fn complete(&self, job: &ClaimedJob, pending: Vec<ImpactRecord>) -> JobEnd {
+    async fn complete(
+        &self,
+        job: &ClaimedJob,
+        pending: Vec<ImpactRecord>,
+        checkpoint: Option<Checkpoint>,
+    ) -> JobEnd {
         let req = CompleteRequest {
             lease_id: job.lease_id,
             impacts: pending,
+            checkpoint,
         };
         match self
             .deliver("complete", || self.client.complete(job.job_id, &req))

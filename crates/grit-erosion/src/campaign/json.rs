@@ -13,7 +13,7 @@ use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 use serde_path_to_error::Segment;
 
-use super::{err, same_angle, Impacts, MaterialSpec, SpecError, Sweep};
+use super::{err, same_angle, ImpactPlan, Impacts, MaterialSpec, SpecError, Sweep, UntilSteady};
 
 impl<'de, T: Deserialize<'de>> Deserialize<'de> for Sweep<T> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -90,11 +90,13 @@ impl<'de> Deserialize<'de> for Impacts {
         impl<'de> Visitor<'de> for ImpactsVisitor {
             type Value = Impacts;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a number or an object {\"15\": 140, \"default\": 60}")
+                f.write_str(
+                    "a number, {\"until_steady\": {...}} or an object {\"15\": 140, \"default\": 60}",
+                )
             }
             fn visit_u64<E: de::Error>(self, n: u64) -> Result<Impacts, E> {
                 u32::try_from(n)
-                    .map(Impacts::All)
+                    .map(|n| Impacts::All(ImpactPlan::Fixed(n)))
                     .map_err(|_| E::custom(not_a_count(n)))
             }
             fn visit_i64<E: de::Error>(self, n: i64) -> Result<Impacts, E> {
@@ -107,15 +109,25 @@ impl<'de> Deserialize<'de> for Impacts {
                 Err(E::custom(not_a_count(Value::from(x))))
             }
             fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Impacts, A::Error> {
-                let (mut angles, mut default) = (Vec::new(), None);
+                let (mut angles, mut default, mut whole) = (Vec::new(), None, None);
                 while let Some(key) = map.next_key::<String>()? {
+                    if key == "until_steady" {
+                        whole = Some(map.next_value::<UntilSteady>()?);
+                        continue;
+                    }
                     map.next_value_seed(AngleEntry {
                         key: &key,
                         angles: &mut angles,
                         default: &mut default,
                     })?;
                 }
-                Ok(Impacts::PerAngle { angles, default })
+                match whole {
+                    Some(_) if !angles.is_empty() || default.is_some() => Err(de::Error::custom(
+                        "`until_steady` is either the whole value or a value under each angle, not a key beside angles",
+                    )),
+                    Some(u) => Ok(Impacts::All(ImpactPlan::UntilSteady(u))),
+                    None => Ok(Impacts::PerAngle { angles, default }),
+                }
             }
         }
         d.deserialize_any(ImpactsVisitor)
@@ -126,14 +138,14 @@ impl<'de> Deserialize<'de> for Impacts {
 /// error about the key names it too (`impacts["fifteen"]`).
 struct AngleEntry<'a> {
     key: &'a str,
-    angles: &'a mut Vec<(f64, u32)>,
-    default: &'a mut Option<u32>,
+    angles: &'a mut Vec<(f64, ImpactPlan)>,
+    default: &'a mut Option<ImpactPlan>,
 }
 
 impl<'de> DeserializeSeed<'de> for AngleEntry<'_> {
     type Value = ();
     fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
-        let n = count(d)?;
+        let n = ImpactPlan::deserialize(d)?;
         if self.key == "default" {
             *self.default = Some(n);
             return Ok(());
@@ -149,7 +161,7 @@ impl<'de> DeserializeSeed<'de> for AngleEntry<'_> {
     }
 }
 
-fn not_a_count(v: impl fmt::Display) -> String {
+pub(super) fn not_a_count(v: impl fmt::Display) -> String {
     format!("must be a whole number ≥ 0, got {v}")
 }
 
@@ -222,7 +234,9 @@ pub(super) fn field_path(path: &serde_path_to_error::Path) -> String {
     for segment in path.iter() {
         match segment {
             Segment::Seq { index } => out.push_str(&format!("[{index}]")),
-            Segment::Map { key } if out == "impacts" => out.push_str(&format!("[\"{key}\"]")),
+            Segment::Map { key } if out == "impacts" && key != "until_steady" => {
+                out.push_str(&format!("[\"{key}\"]"))
+            }
             Segment::Map { key } | Segment::Enum { variant: key } => {
                 if !out.is_empty() {
                     out.push('.');

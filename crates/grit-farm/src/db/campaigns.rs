@@ -28,7 +28,9 @@ impl Store {
     ) -> Result<CampaignCreated> {
         let cells = spec.cells()?;
         let impacts_total = spec.impacts_total()?;
-        let jobs_total = cells.len() as u64 * spec.samples as u64;
+        let samples = spec.samples.initial();
+        let target = spec.samples.target_sem();
+        let jobs_total = cells.len() as u64 * samples as u64;
         let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
         let mut tx = self.begin().await?;
         if let Some(key) = idempotency_key {
@@ -62,7 +64,7 @@ impl Store {
         .bind(id.to_string())
         .bind(&spec.name)
         .bind(&spec_json)
-        .bind(spec.samples as i64)
+        .bind(samples as i64)
         .bind(impacts_total as i64)
         .bind(self.max_attempts as i64)
         .bind(idempotency_key)
@@ -72,8 +74,9 @@ impl Store {
         .get(0);
         for cell in &cells {
             sqlx::query(
-                "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, impacts, params)
-                 VALUES (?, ?, ?, ?, ?, ?, ?)",
+                "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, impacts, params,
+                                    samples, impacts_max, impacts_step, samples_max, target_sem_rel)
+                 VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             )
             .bind(id.to_string())
             .bind(cell.index as i64)
@@ -85,6 +88,11 @@ impl Store {
                 serde_json::to_string(&cell.params)
                     .map_err(|e| Error::Internal(e.to_string()))?,
             )
+            .bind(samples as i64)
+            .bind(cell.until_steady.map(|u| u.max as i64))
+            .bind(cell.until_steady.map(|u| u.step as i64))
+            .bind(target.map(|t| t.max as i64))
+            .bind(target.map(|t| t.target_sem_rel))
             .execute(&mut *tx)
             .await?;
         }
@@ -93,7 +101,7 @@ impl Store {
         let jobs: Vec<(u32, u32, u32, u64)> = cells
             .iter()
             .flat_map(|c| {
-                (0..spec.samples).map(move |s| {
+                (0..samples).map(move |s| {
                     (
                         c.index,
                         s,
@@ -201,10 +209,9 @@ impl Store {
                 _ => counts.cancelled += n,
             }
         }
-        let samples = c.get::<i64, _>("samples") as u64;
         let mut cells = Vec::new();
         for r in sqlx::query(
-            "SELECT k.cell_index, k.angle_deg, k.shape, k.swept, k.impacts,
+            "SELECT k.cell_index, k.angle_deg, k.shape, k.swept, k.impacts, k.samples,
                     COALESCE(SUM(j.impacts_done), 0) AS done,
                     COALESCE(SUM(j.state = 'done'), 0) AS samples_done
              FROM cells k LEFT JOIN jobs j
@@ -215,6 +222,7 @@ impl Store {
         .fetch_all(&self.read)
         .await?
         {
+            let samples = r.get::<i64, _>("samples") as u64;
             cells.push(CellProgress {
                 cell: r.get::<i64, _>("cell_index") as u32,
                 angle_deg: r.get("angle_deg"),
@@ -311,26 +319,34 @@ impl Store {
                 });
             }
         }
+        // Cells that grew are planned as they are now, not as the spec first planned them.
+        let plans = self.cell_plans(id).await?;
         let inputs: Vec<_> = cells
             .iter()
             .zip(per_cell)
-            .map(|(cell, samples)| {
-                cell.input(
-                    spec.samples,
+            .zip(&plans)
+            .map(|((cell, samples), plan)| {
+                let mut input = cell.input(
+                    plan.samples,
                     samples
                         .into_iter()
                         .map(|(sample, impacts)| SampleInput { sample, impacts })
                         .collect(),
-                )
+                );
+                input.planned_impacts = plan.impacts as usize;
+                input
             })
             .collect();
         // The stored spec is the parsed one written back, every default filled in, so a
         // reader of the results can rerun exactly this campaign.
         let spec_value: serde_json::Value = serde_json::from_str(&spec_text)
             .map_err(|e| Error::Internal(format!("stored spec: {e}")))?;
-        let results = aggregate_campaign(&inputs, grit_erosion::SLOPE_WINDOW)
+        let mut results = aggregate_campaign(&inputs, grit_erosion::SLOPE_WINDOW)
             .map_err(|e| Error::Internal(format!("aggregation: {e}")))?
             .with_spec(spec_value);
+        for (cell, plan) in results.cells.iter_mut().zip(&plans) {
+            grit_erosion::campaign::annotate(cell, plan.until, plan.target);
+        }
         let raw = if raw {
             Some(self.raw_series(id).await?)
         } else {

@@ -17,9 +17,12 @@ use uuid::Uuid;
 use crate::error::{Error, Result};
 
 mod campaigns;
+mod extend;
 mod worker;
 mod workers;
 
+#[cfg(test)]
+mod extend_tests;
 #[cfg(test)]
 mod tests;
 

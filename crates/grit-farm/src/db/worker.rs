@@ -100,13 +100,17 @@ impl Store {
         let job_id: i64 = r.get("id");
         let campaign: String = r.get("campaign_id");
         let cell: i64 = r.get("cell_index");
-        let params: String =
-            sqlx::query("SELECT params FROM cells WHERE campaign_id = ? AND cell_index = ?")
-                .bind(&campaign)
-                .bind(cell)
-                .fetch_one(&mut *tx)
-                .await?
-                .get(0);
+        let cell_row = sqlx::query(
+            "SELECT params, impacts, impacts_max FROM cells WHERE campaign_id = ? AND cell_index = ?",
+        )
+        .bind(&campaign)
+        .bind(cell)
+        .fetch_one(&mut *tx)
+        .await?;
+        let params: String = cell_row.get(0);
+        let extendable = cell_row
+            .get::<Option<i64>, _>(2)
+            .is_some_and(|max| cell_row.get::<i64, _>(1) < max);
         let params: ImpactParams = serde_json::from_str(&params)
             .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
         let ckpt = load_checkpoint(&mut tx, job_id).await?;
@@ -123,6 +127,7 @@ impl Store {
             impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
             impacts_done: r.get::<i64, _>("impacts_done") as u32,
             params,
+            extendable,
             checkpoint: ckpt.map(|c| Checkpoint {
                 impacts_done: c.impacts_done,
                 data_b64: base64::engine::general_purpose::STANDARD.encode(c.data),
@@ -159,13 +164,21 @@ impl Store {
     }
 
     /// Stores the last impacts and marks the job done; it must then have every planned impact.
-    pub async fn complete(&self, job_id: i64, lease: Uuid, impacts: &[ImpactRecord]) -> Result<()> {
+    /// The checkpoint after the last impact is kept when the job's cell may still grow, and
+    /// a cell whose last job this was is assessed and grown in the same transaction.
+    pub async fn complete(
+        &self,
+        job_id: i64,
+        lease: Uuid,
+        impacts: &[ImpactRecord],
+        checkpoint: Option<&Checkpoint>,
+    ) -> Result<()> {
         let Report {
             mut tx,
             now,
             held,
             done,
-        } = self.report(job_id, lease, impacts, None).await?;
+        } = self.report(job_id, lease, impacts, checkpoint).await?;
         if done < held.planned {
             return Err(Error::invalid(
                 "impacts",
@@ -176,10 +189,14 @@ impl Store {
             ));
         }
         end_lease(&mut tx, job_id, "done", done, now).await?;
-        sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
-            .bind(job_id)
-            .execute(&mut *tx)
-            .await?;
+        let (campaign, cell, plan) = super::extend::plan_of_job(&mut tx, job_id).await?;
+        if !plan.impacts_may_grow() {
+            sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
+                .bind(job_id)
+                .execute(&mut *tx)
+                .await?;
+        }
+        super::extend::settle_cell(&mut tx, &campaign, cell, plan, now).await?;
         tx.commit().await?;
         tracing::debug!(job = job_id, "job done");
         Ok(())

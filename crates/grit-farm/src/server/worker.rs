@@ -90,7 +90,9 @@ async fn complete(
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<CompleteRequest>,
 ) -> Result<StatusCode> {
-    s.store.complete(job, req.lease_id, &req.impacts).await?;
+    s.store
+        .complete(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
+        .await?;
     Ok(StatusCode::NO_CONTENT)
 }
 

@@ -1,0 +1,232 @@
+//! Cells that grow with their results, driven through the store with fabricated impacts (no
+//! physics): extension by `step`, the stop at `max`, samples added for the error bar.
+
+use std::path::Path;
+use std::time::Duration;
+
+use grit_erosion::campaign::{job_seed, CampaignSpec};
+use grit_erosion::{ImpactOutcome, ImpactRecord};
+use sqlx::Row;
+use uuid::Uuid;
+
+use super::Store;
+use crate::api::{CampaignState, Checkpoint, ClaimedJob};
+
+async fn store(dir: &Path) -> Store {
+    Store::open(&dir.join("t.db"), Duration::from_secs(60), 2)
+        .await
+        .unwrap()
+}
+
+fn spec(impacts: &str, samples: &str) -> CampaignSpec {
+    CampaignSpec::from_json(&format!(
+        r#"{{"seed": 5, "angles_deg": [90], "shapes": ["hexagon"], "spacing_m": 25e-6,
+            "impacts": {impacts}, "samples": {samples}}}"#
+    ))
+    .unwrap()
+}
+
+/// Impact `k` (1-based) of a sample losing `loss(k)` × its grain mass.
+fn record(k: u32, loss: f64) -> ImpactRecord {
+    ImpactRecord {
+        impact: k,
+        grain_mass_kg: 1e-4,
+        mass_loss_kg: loss * 1e-4,
+        orientation_rad: 0.0,
+        aim_x_m: 0.0,
+        outcome: ImpactOutcome {
+            mass_loss_kg: loss * 1e-4,
+            removed_particles: 0,
+            detached_kg: 0.0,
+            detached_particles: 0,
+            sim_time_s: 0.0,
+            steps: 0,
+            rebound_ratio: 0.0,
+            settled: true,
+        },
+    }
+}
+
+/// A stand-in for the sample's state after its last impact.
+fn checkpoint(j: &ClaimedJob) -> Checkpoint {
+    Checkpoint {
+        impacts_done: j.impacts_planned,
+        data_b64: "AAAA".into(),
+    }
+}
+
+/// Claims the next job and completes it with impacts lost at `loss(sample, k)`, sending a
+/// checkpoint when the claim asks for one. Returns the claim.
+async fn run_one(s: &Store, loss: impl Fn(u32, u32) -> f64) -> ClaimedJob {
+    let j = s.claim("w").await.unwrap().expect("a queued job");
+    let recs: Vec<ImpactRecord> = (j.impacts_done + 1..=j.impacts_planned)
+        .map(|k| record(k, loss(j.sample, k)))
+        .collect();
+    let ckpt = j.extendable.then(|| checkpoint(&j));
+    s.complete(j.job_id, j.lease_id, &recs, ckpt.as_ref())
+        .await
+        .unwrap();
+    j
+}
+
+async fn checkpoints(s: &Store) -> i64 {
+    sqlx::query("SELECT COUNT(*) FROM checkpoints")
+        .fetch_one(&s.read)
+        .await
+        .unwrap()
+        .get(0)
+}
+
+#[tokio::test]
+async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec(
+        r#"{"until_steady": {"min": 21, "max": 25, "step": 3}}"#,
+        "2",
+    );
+    let id = s.create_campaign(&sp, None).await.unwrap().id;
+    // Nothing is ever lost: never steady.
+    let a = run_one(&s, |_, _| 0.0).await;
+    assert!(a.extendable && a.impacts_planned == 21 && a.checkpoint.is_none());
+    let st = s.status(id).await.unwrap();
+    assert_eq!((st.jobs.done, st.jobs.queued, st.impacts_total), (1, 1, 42));
+    assert_eq!(checkpoints(&s).await, 1, "kept: the cell may grow");
+    run_one(&s, |_, _| 0.0).await;
+    // The last job of the cell done: every sample is planned for 24 and queued again.
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.state, CampaignState::Running);
+    assert_eq!(
+        (st.jobs.queued, st.impacts_total, st.impacts_done),
+        (2, 48, 42)
+    );
+    assert_eq!(st.cells[0].impacts_total, 48);
+    let b = run_one(&s, |_, _| 0.0).await;
+    assert_eq!((b.impacts_done, b.impacts_planned), (21, 24));
+    assert!(b.extendable);
+    assert_eq!(b.checkpoint.as_ref().map(|c| c.impacts_done), Some(21));
+    run_one(&s, |_, _| 0.0).await;
+    // 24 + 3 is capped at 25; the jobs then run without needing a checkpoint afterwards.
+    let c = run_one(&s, |_, _| 0.0).await;
+    assert_eq!((c.impacts_planned, c.extendable), (25, false));
+    run_one(&s, |_, _| 0.0).await;
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.state, CampaignState::Done);
+    assert_eq!((st.impacts_total, st.impacts_done), (50, 50));
+    assert!(s.claim("w").await.unwrap().is_none());
+    assert_eq!(checkpoints(&s).await, 0, "dropped once the cell is final");
+    let r = s.results(id, false).await.unwrap().results;
+    let cell = &r.cells[0];
+    assert_eq!(cell.impacts_planned, 25);
+    assert!(!cell.partial);
+    let ss = cell.steady_state.as_ref().unwrap();
+    assert!(!ss.steady);
+    assert!(
+        ss.reason.starts_with("reached max 25 impacts; "),
+        "{}",
+        ss.reason
+    );
+    assert_eq!(r.steady, Some(false));
+}
+
+#[tokio::test]
+async fn a_steady_cell_is_not_extended() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec(
+        r#"{"until_steady": {"min": 21, "max": 60, "step": 5}}"#,
+        "2",
+    );
+    let id = s.create_campaign(&sp, None).await.unwrap().id;
+    // The same loss from the first impact on: linear, past incubation, steady.
+    run_one(&s, |_, _| 0.3).await;
+    run_one(&s, |_, _| 0.3).await;
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.state, CampaignState::Done);
+    assert_eq!(st.impacts_total, 42);
+    assert_eq!(checkpoints(&s).await, 0);
+    let r = s.results(id, false).await.unwrap().results;
+    assert_eq!(r.cells[0].impacts_planned, 21);
+    assert_eq!(r.steady, Some(true));
+}
+
+#[tokio::test]
+async fn samples_are_added_until_the_error_bar_or_max() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec("21", r#"{"target_sem_rel": 0.01, "min": 2, "max": 5}"#);
+    let id = s.create_campaign(&sp, None).await.unwrap().id;
+    // Samples erode at clearly different rates: the error bar is far above 1 %.
+    let rate = |sample: u32, _| 0.1 + 0.1 * sample as f64;
+    let a = run_one(&s, rate).await;
+    assert!(!a.extendable);
+    run_one(&s, rate).await;
+    let st = s.status(id).await.unwrap();
+    assert_eq!(
+        (st.jobs.done, st.jobs.queued),
+        (2, 3),
+        "grown straight to max"
+    );
+    assert_eq!(st.impacts_total, 5 * 21);
+    assert_eq!(st.cells[0].samples_total, 5);
+    let mut seen = Vec::new();
+    for _ in 0..3 {
+        let j = run_one(&s, rate).await;
+        assert_eq!(j.seed, job_seed(5, 0, j.sample), "seeds follow job_seed");
+        assert_eq!(j.impacts_planned, 21);
+        seen.push(j.sample);
+    }
+    assert_eq!(seen, [2, 3, 4]);
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.state, CampaignState::Done);
+    let r = s.results(id, false).await.unwrap().results;
+    let cell = &r.cells[0];
+    assert_eq!((cell.samples, cell.samples_planned), (5, 5));
+    let rel = cell
+        .erosion_sem_rel
+        .expect("reported for a target_sem cell");
+    assert!(rel > 0.01, "stopped at max above the target: {rel}");
+}
+
+#[tokio::test]
+async fn samples_stop_once_the_target_is_met() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec("21", r#"{"target_sem_rel": 0.5, "min": 2, "max": 50}"#);
+    let id = s.create_campaign(&sp, None).await.unwrap().id;
+    // sem/mean = 0.5/√2·(0.2/0.3)... : with rates 0.2 and 0.4, sem = 0.1, mean = 0.3.
+    let rate = |sample: u32, _| 0.2 + 0.2 * sample as f64;
+    run_one(&s, rate).await;
+    run_one(&s, rate).await;
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.state, CampaignState::Done, "1/3 ≤ 0.5: no sample added");
+    let r = s.results(id, false).await.unwrap().results;
+    let rel = r.cells[0].erosion_sem_rel.unwrap();
+    assert!((rel - 1.0 / 3.0).abs() < 1e-9, "{rel}");
+}
+
+#[tokio::test]
+async fn a_repeated_complete_grows_nothing_twice() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec(
+        r#"{"until_steady": {"min": 21, "max": 40, "step": 4}}"#,
+        "1",
+    );
+    let id = s.create_campaign(&sp, None).await.unwrap().id;
+    let j = run_one(&s, |_, _| 0.0).await;
+    // The worker did not hear the answer and sends the same complete again.
+    let e = s
+        .complete(j.job_id, j.lease_id, &[], Some(&checkpoint(&j)))
+        .await
+        .unwrap_err();
+    assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
+    let st = s.status(id).await.unwrap();
+    assert_eq!((st.jobs.queued, st.impacts_total), (1, 25));
+    let e = s
+        .complete(j.job_id, Uuid::new_v4(), &[], None)
+        .await
+        .unwrap_err();
+    assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
+    assert_eq!(s.status(id).await.unwrap().impacts_total, 25);
+}
