@@ -53,9 +53,6 @@ async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
     s
 }
 
-
-
-
 fn grit_cli(url: &str, args: &[&str]) -> std::process::Output {
     Command::new(GRIT)
         .args(args)

@@ -297,7 +297,10 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
     let during = raw_series(&c.results_value(id, true).await.unwrap());
     assert_eq!(during.len(), before.len());
     for ((_, _, a), (_, _, b)) in before.iter().zip(&during) {
-        assert!(b.len() >= a.len() && b[..a.len()] == a[..], "stored impacts changed");
+        assert!(
+            b.len() >= a.len() && b[..a.len()] == a[..],
+            "stored impacts changed"
+        );
     }
 
     std::fs::remove_file(&filler).unwrap();

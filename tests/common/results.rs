@@ -26,7 +26,10 @@ pub fn raw_series(results: &Value) -> Vec<(u64, u64, Vec<ImpactRecord>)> {
 }
 
 /// Bit-for-bit equality of two sets of per-impact series.
-pub fn assert_bitwise_equal(a: &[(u64, u64, Vec<ImpactRecord>)], b: &[(u64, u64, Vec<ImpactRecord>)]) {
+pub fn assert_bitwise_equal(
+    a: &[(u64, u64, Vec<ImpactRecord>)],
+    b: &[(u64, u64, Vec<ImpactRecord>)],
+) {
     assert_eq!(a.len(), b.len());
     for ((ca, sa, ra), (cb, sb, rb)) in a.iter().zip(b) {
         assert_eq!((ca, sa), (cb, sb));
