@@ -6,13 +6,13 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use grit_erosion::ImpactRecord;
 use grit_farm::api::{CampaignState, CampaignStatus};
 use grit_farm::{Client, Secret};
 use serde_json::Value;
 use uuid::Uuid;
 
 mod common;
+use common::results::{assert_bitwise_equal, grit_run, raw_series};
 use common::{
     start_coordinator, start_worker, wait_for, Coordinator, GRIT, SERIAL, SUBMIT, WORKER,
 };
@@ -51,64 +51,6 @@ async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
     let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
     assert_eq!(s.state, CampaignState::Done);
     s
-}
-
-fn raw_series(results: &Value) -> Vec<(u64, u64, Vec<ImpactRecord>)> {
-    results["raw"]
-        .as_array()
-        .expect("raw series present")
-        .iter()
-        .map(|s| {
-            (
-                s["cell"].as_u64().unwrap(),
-                s["sample"].as_u64().unwrap(),
-                serde_json::from_value(s["impacts"].clone()).unwrap(),
-            )
-        })
-        .collect()
-}
-
-/// Bit-for-bit equality of two sets of per-impact series.
-fn assert_bitwise_equal(a: &[(u64, u64, Vec<ImpactRecord>)], b: &[(u64, u64, Vec<ImpactRecord>)]) {
-    assert_eq!(a.len(), b.len());
-    for ((ca, sa, ra), (cb, sb, rb)) in a.iter().zip(b) {
-        assert_eq!((ca, sa), (cb, sb));
-        assert_eq!(ra.len(), rb.len(), "cell {ca} sample {sa}: impact counts");
-        for (x, y) in ra.iter().zip(rb) {
-            assert_eq!(
-                x.mass_loss_kg.to_bits(),
-                y.mass_loss_kg.to_bits(),
-                "impact {}",
-                x.impact
-            );
-            assert_eq!(x.grain_mass_kg.to_bits(), y.grain_mass_kg.to_bits());
-            assert_eq!(x.orientation_rad.to_bits(), y.orientation_rad.to_bits());
-            assert_eq!(x.aim_x_m.to_bits(), y.aim_x_m.to_bits());
-            assert_eq!(
-                x.outcome.sim_time_s.to_bits(),
-                y.outcome.sim_time_s.to_bits()
-            );
-            assert_eq!(x, y);
-        }
-    }
-}
-
-/// `grit run` of `spec` into `out`; returns results.json.
-fn grit_run(dir: &Path, spec: &str, out: &str, raw: bool) -> Value {
-    let file = dir.join(format!("{out}.json"));
-    std::fs::write(&file, spec).unwrap();
-    let out_dir = dir.join(out);
-    let mut cmd = Command::new(GRIT);
-    cmd.arg("run")
-        .arg(&file)
-        .args(["--workers", "1", "--threads", "1", "--quiet", "--out"])
-        .arg(&out_dir);
-    if raw {
-        cmd.arg("--raw");
-    }
-    let status = cmd.status().expect("grit run starts");
-    assert!(status.success(), "grit run failed");
-    serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap()
 }
 
 fn grit_cli(url: &str, args: &[&str]) -> std::process::Output {

@@ -26,8 +26,8 @@ pub struct BenchArgs {
 
 #[derive(Subcommand, Debug)]
 enum BenchWhat {
-    /// The coordinator's load test: claims+completions/s at several client counts and
-    /// heartbeat latency, with jobs that do no simulation.
+    /// The coordinator's load test: claims+completions/s at several client counts,
+    /// heartbeat latency and failed requests, with jobs that do no simulation.
     #[command(after_help = "Example: grit bench farm --clients 1,8 --seconds 5")]
     Farm {
         /// Concurrent clients, comma-separated.

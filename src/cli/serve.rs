@@ -86,6 +86,10 @@ pub struct WorkArgs {
     /// Seconds between claims while the queue is empty.
     #[arg(long, default_value_t = 5.0)]
     pub poll_s: f64,
+    /// Seconds a request to the coordinator may take before the worker gives up on it and
+    /// retries (a stalled coordinator holds requests open); must cover a checkpoint upload.
+    #[arg(long, env = "GRIT_REQUEST_TIMEOUT_S", default_value_t = grit_farm::client::DEFAULT_REQUEST_TIMEOUT.as_secs_f64())]
+    pub request_timeout_s: f64,
 }
 
 /// `grit serve`: the coordinator until SIGTERM or SIGINT.
@@ -137,7 +141,17 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
 /// `grit work`: leases and runs jobs until stopped (or idle with `--exit-when-idle`).
 pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
     let token = read_token(a.token, a.token_file, "token")?;
-    let client = Client::new(&a.coordinator, token)?;
+    if !(a.request_timeout_s.is_finite() && a.request_timeout_s > 0.0) {
+        bail!(
+            "--request-timeout-s must be > 0, got {}",
+            a.request_timeout_s
+        );
+    }
+    let client = Client::with_timeout(
+        &a.coordinator,
+        token,
+        Duration::from_secs_f64(a.request_timeout_s),
+    )?;
     if a.checkpoint_every == 0 {
         bail!("--checkpoint-every must be at least 1");
     }

@@ -11,6 +11,8 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
+pub mod results;
+
 pub const GRIT: &str = env!("CARGO_BIN_EXE_grit");
 pub const SUBMIT: &str = "submit-token-for-tests";
 pub const WORKER: &str = "worker-token-for-tests";
@@ -71,10 +73,23 @@ pub fn start_coordinator(
     lease_ttl_s: f64,
     extra: &[&str],
 ) -> Coordinator {
+    start_coordinator_on(&dir.join("farm.db"), dir, tag, listen, lease_ttl_s, extra)
+}
+
+/// `start_coordinator` with the database at `db`, which may lie on another filesystem than
+/// the log in `dir`.
+pub fn start_coordinator_on(
+    db: &Path,
+    dir: &Path,
+    tag: &str,
+    listen: &str,
+    lease_ttl_s: f64,
+    extra: &[&str],
+) -> Coordinator {
     let log = dir.join(format!("coordinator-{tag}.log"));
     let mut child = Command::new(GRIT)
         .args(["serve", "--db"])
-        .arg(dir.join("farm.db"))
+        .arg(db)
         .args([
             "--listen",
             listen,

@@ -10,6 +10,10 @@ use uuid::Uuid;
 use crate::api::*;
 use crate::server::Secret;
 
+/// How long a request may take before the client gives up on it: long enough for a
+/// checkpoint upload of a few MB over a slow link.
+pub const DEFAULT_REQUEST_TIMEOUT: Duration = Duration::from_secs(300);
+
 /// Why a call failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ClientError {
@@ -59,11 +63,22 @@ pub struct Client {
 }
 
 impl Client {
-    /// A client for `base` (e.g. `http://127.0.0.1:8080`), sending `token` if any.
+    /// A client for `base` (e.g. `http://127.0.0.1:8080`), sending `token` if any, whose
+    /// requests time out after [`DEFAULT_REQUEST_TIMEOUT`].
     pub fn new(base: &str, token: Secret) -> Result<Client, ClientError> {
+        Self::with_timeout(base, token, DEFAULT_REQUEST_TIMEOUT)
+    }
+
+    /// A client whose requests give up after `request_timeout` (counted as unreachable, so
+    /// retried): how long a stalled coordinator can hold a worker's heartbeat.
+    pub fn with_timeout(
+        base: &str,
+        token: Secret,
+        request_timeout: Duration,
+    ) -> Result<Client, ClientError> {
         let http = reqwest::Client::builder()
-            .connect_timeout(Duration::from_secs(10))
-            .timeout(Duration::from_secs(300))
+            .connect_timeout(Duration::from_secs(10).min(request_timeout))
+            .timeout(request_timeout)
             .build()
             .map_err(|e| ClientError::Unreachable(e.to_string()))?;
         Ok(Client {

@@ -37,7 +37,7 @@ pub enum Error {
     /// The job was cancelled; its worker should drop it (410).
     #[error("{0}")]
     Gone(String),
-    /// Database failure (500; details logged, not sent).
+    /// Database failure (500, or 503 when its disk is full; details logged, not sent).
     #[error(transparent)]
     Db(#[from] sqlx::Error),
     /// Migration failure at start-up.
@@ -47,6 +47,9 @@ pub enum Error {
     #[error("{0}")]
     Internal(String),
 }
+
+/// SQLite's result code for a write that found no space left.
+const SQLITE_FULL: i32 = 13;
 
 /// Result with the coordinator's error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
@@ -60,9 +63,24 @@ impl Error {
         }
     }
 
+    /// Whether SQLite refused a write because the database's filesystem is full
+    /// (`SQLITE_FULL`, "database or disk is full"): nothing was written, and the same request
+    /// succeeds once space is freed, so it is answered 503 rather than 500.
+    pub fn is_disk_full(&self) -> bool {
+        match self {
+            Error::Db(sqlx::Error::Database(e)) => e
+                .code()
+                .and_then(|c| c.parse::<i32>().ok())
+                // The primary result code is the low byte of an extended one.
+                .is_some_and(|c| c & 0xff == SQLITE_FULL),
+            _ => false,
+        }
+    }
+
     /// The HTTP status this error is answered with.
     pub fn status(&self) -> StatusCode {
         match self {
+            e if e.is_disk_full() => StatusCode::SERVICE_UNAVAILABLE,
             Error::Invalid { .. } => StatusCode::UNPROCESSABLE_ENTITY,
             Error::BadRequest { status, .. } => *status,
             Error::Unauthorized => StatusCode::UNAUTHORIZED,
@@ -89,6 +107,13 @@ impl IntoResponse for Error {
     fn into_response(self) -> Response {
         let status = self.status();
         let body = match &self {
+            e if e.is_disk_full() => {
+                tracing::error!(error = %self, "the database's disk is full: free space on it; workers retry the refused writes");
+                ErrorBody {
+                    error: "the coordinator's database disk is full (SQLITE_FULL); nothing was stored, retry once space is freed".into(),
+                    field: None,
+                }
+            }
             Error::Invalid { field, rule } => ErrorBody {
                 error: format!("{field}: {rule}"),
                 field: Some(field.clone()),

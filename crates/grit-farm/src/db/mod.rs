@@ -59,6 +59,7 @@ impl Store {
             .foreign_keys(true);
         let write = SqlitePoolOptions::new()
             .max_connections(1)
+            .after_release(|conn, _| Box::pin(release_writer(conn)))
             .connect_with(opts.clone())
             .await?;
         sqlx::migrate!("../../migrations").run(&write).await?;
@@ -83,6 +84,28 @@ impl Store {
         sqlx::query("SELECT 1").execute(&self.read).await?;
         Ok(())
     }
+}
+
+/// Whether the writer connection may go back to the pool. Some errors, `SQLITE_FULL` among
+/// them, make SQLite roll the transaction back by itself; the `ROLLBACK` sqlx then sends for
+/// the dropped transaction fails, and sqlx keeps counting the connection as inside a
+/// transaction, so every later `BEGIN` on it would be refused. Such a connection is closed and
+/// the pool opens a fresh one, so the store works again as soon as the disk has space.
+async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool> {
+    use sqlx::Connection;
+    if !conn.is_in_transaction() {
+        return Ok(true);
+    }
+    // A dropped transaction's rollback is queued on the connection, not yet run: a ping
+    // waits for it.
+    conn.ping().await?;
+    let clean = !conn.is_in_transaction();
+    if !clean {
+        tracing::warn!(
+            "the database rolled back a failed transaction itself; reopening the writer connection"
+        );
+    }
+    Ok(clean)
 }
 
 /// Parses a uuid the store wrote.

@@ -147,3 +147,44 @@ async fn results_carry_the_spec_as_run_the_version_and_the_steady_check() {
         assert!(json.get(key).is_some(), "{key} in {json}");
     }
 }
+
+/// Some errors (`SQLITE_FULL` among them) make SQLite roll the transaction back by itself;
+/// the writer must still take the next transaction.
+#[tokio::test]
+async fn a_transaction_rolled_back_by_sqlite_does_not_wedge_the_writer() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    {
+        let mut tx = s.begin().await.unwrap();
+        // What SQLite does on its own after such an error.
+        sqlx::query("ROLLBACK").execute(&mut *tx).await.unwrap();
+    }
+    let spec = CampaignSpec::from_json(TINY).unwrap();
+    s.create_campaign(&spec, None).await.unwrap();
+}
+
+/// A write that finds no space is a 503 naming the cause, stores nothing, and the same write
+/// succeeds once there is space again.
+#[tokio::test]
+async fn a_full_database_is_503_and_recovers() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let big =
+        CampaignSpec::from_json(&TINY.replace(r#""samples": 2"#, r#""samples": 5000"#)).unwrap();
+    // SQLite's cap on the database's pages stands in for a full disk: the same SQLITE_FULL.
+    sqlx::query("PRAGMA max_page_count = 1")
+        .execute(&s.write)
+        .await
+        .unwrap();
+    let e = s.create_campaign(&big, None).await.unwrap_err();
+    assert!(e.is_disk_full(), "{e}");
+    assert_eq!(e.status(), axum::http::StatusCode::SERVICE_UNAVAILABLE);
+    assert!(e.to_string().contains("database or disk is full"), "{e}");
+    assert!(s.list_campaigns().await.unwrap().is_empty());
+    sqlx::query("PRAGMA max_page_count = 1073741823")
+        .execute(&s.write)
+        .await
+        .unwrap();
+    s.create_campaign(&big, None).await.unwrap();
+    assert_eq!(s.list_campaigns().await.unwrap().len(), 1);
+}

@@ -1,0 +1,326 @@
+//! Faults a shared cluster throws at the farm, end to end with the real `grit` binary over
+//! loopback and a fresh database per test: the coordinator killed with `kill -9` and
+//! restarted on its database, the coordinator frozen (`SIGSTOP`) past a worker's request
+//! timeout and past the lease, and the coordinator's disk filling up. Each campaign must
+//! still complete with impact records bit-equal to `grit run`'s, each impact stored once.
+//! docs/operations.md describes what an operator sees and does in each case.
+//! Set TEST_LOG=1 to see the processes' logs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use grit_erosion::ImpactRecord;
+use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_farm::{Client, Secret};
+use uuid::Uuid;
+
+mod common;
+use common::results::{assert_bitwise_equal, grit_run, raw_series};
+use common::{start_coordinator, start_coordinator_on, start_worker, wait_for, Proc, SERIAL};
+
+type Series = Vec<(u64, u64, Vec<ImpactRecord>)>;
+
+/// The coarsest real scene at 60°.
+fn campaign(samples: u32, impacts: u32) -> String {
+    common::campaign("faults", "[60]", samples, impacts)
+}
+
+fn submitter(url: &str) -> Client {
+    Client::new(url, Secret::new(Some(common::SUBMIT.into()))).unwrap()
+}
+
+/// A worker that uploads a checkpoint with every impact, with `extra` flags.
+fn worker(dir: &Path, url: &str, name: &str, extra: &[&str]) -> Proc {
+    let mut args = vec!["--checkpoint-every", "1"];
+    args.extend_from_slice(extra);
+    start_worker(dir, url, name, &args)
+}
+
+/// Waits up to `limit` for the campaign to finish, which it must do as `done`.
+async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
+    let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
+    assert_eq!(s.state, CampaignState::Done, "{s:?}");
+    s
+}
+
+/// Waits up to `limit` until at least `n` impacts are stored.
+async fn wait_impacts(c: &Client, id: Uuid, n: u64, limit: Duration) -> CampaignStatus {
+    let what = format!("{n} impacts");
+    wait_for(limit, &what, || c.status(id), |s| s.impacts_done >= n).await
+}
+
+/// Sends `signal` (a `kill` name such as `STOP`) to `proc`.
+fn signal(proc: &Proc, signal: &str) {
+    let pid = proc.child.id().to_string();
+    let ok = Command::new("kill")
+        .args([&format!("-{signal}"), &pid])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "kill -{signal} {pid}");
+}
+
+/// Fails unless every worker process is still running.
+fn assert_alive(workers: &mut [&mut Proc]) {
+    for w in workers.iter_mut() {
+        assert!(
+            w.child.try_wait().unwrap().is_none(),
+            "a worker exited:\n{}",
+            w.log_text()
+        );
+    }
+}
+
+/// Each job's stored impacts are exactly 1..=`planned`, in order: none lost, none twice.
+fn assert_each_impact_once(farm: &Series, planned: u32) {
+    for (cell, sample, records) in farm {
+        let numbers: Vec<u32> = records.iter().map(|r| r.impact).collect();
+        let expected: Vec<u32> = (1..=planned).collect();
+        assert_eq!(numbers, expected, "cell {cell} sample {sample}");
+    }
+}
+
+/// The stored series, their count per job, and their bits against `grit run` of `spec`.
+async fn assert_matches_grit_run(c: &Client, id: Uuid, dir: &Path, spec: &str, planned: u32) {
+    let farm = raw_series(&c.results_value(id, true).await.unwrap());
+    assert_each_impact_once(&farm, planned);
+    let local = raw_series(&grit_run(dir, spec, "local", true));
+    assert_bitwise_equal(&farm, &local);
+}
+
+/// `kill -9` of the coordinator twice while two workers heartbeat and upload checkpoints;
+/// each time it comes back on the same database and address and the workers carry on.
+#[tokio::test(flavor = "multi_thread")]
+async fn coordinator_killed_twice_mid_campaign_loses_and_repeats_nothing() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = campaign(2, 4);
+    let mut coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", 30.0, &[]);
+    let url = coord.url.clone();
+    // Workers know the coordinator by URL only, so it comes back on the same address.
+    let listen = url.trim_start_matches("http://").to_string();
+    let c = submitter(&url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let mut w1 = worker(dir.path(), &url, "w1", &[]);
+    let mut w2 = worker(dir.path(), &url, "w2", &[]);
+    let limit = Duration::from_secs(120);
+    for (round, (after, tag)) in [(2, "b"), (5, "c")].into_iter().enumerate() {
+        let mid = wait_impacts(&c, id, after, limit).await;
+        assert!(
+            mid.impacts_done < mid.impacts_total,
+            "round {round}: the campaign must still be running when the coordinator dies"
+        );
+        coord.proc.kill9();
+        // Long enough for the workers to find it gone and start backing off.
+        tokio::time::sleep(Duration::from_secs(2)).await;
+        assert_alive(&mut [&mut w1, &mut w2]);
+        coord = start_coordinator(dir.path(), tag, &listen, 30.0, &[]);
+        let now = c.status(id).await.unwrap();
+        assert!(
+            now.impacts_done >= mid.impacts_done,
+            "round {round}: stored impacts survive the crash ({} then {})",
+            mid.impacts_done,
+            now.impacts_done
+        );
+    }
+    let s = wait_done(&c, id, Duration::from_secs(180)).await;
+    assert_eq!(s.impacts_done, s.impacts_total);
+    assert_eq!(s.impacts_total, 8);
+    assert_matches_grit_run(&c, id, dir.path(), &spec, 4).await;
+    let logs = w1.log_text() + &w2.log_text();
+    assert!(
+        logs.contains("unreachable"),
+        "the workers saw the coordinator gone:\n{logs}"
+    );
+    assert_alive(&mut [&mut w1, &mut w2]);
+}
+
+/// `SIGSTOP` of the coordinator, first past the worker's request timeout but within the
+/// lease (the worker retries and keeps its job), then past the lease (the worker's next
+/// report is refused with 409, it drops the job, claims it again and resumes from the
+/// checkpoint); the records still equal `grit run`'s.
+#[tokio::test(flavor = "multi_thread")]
+async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = campaign(1, 8);
+    // A 12 s lease is renewed every 4 s; a 5 s freeze spans at least one heartbeat (which
+    // times out after 1 s) yet leaves the lease alive: the last renewal is at most 4 s
+    // before the freeze and the next at most 4 s after it.
+    let lease_s = 12.0;
+    let coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", lease_s, &[]);
+    let c = submitter(&coord.url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let mut w = worker(dir.path(), &coord.url, "w1", &["--request-timeout-s", "1"]);
+    let limit = Duration::from_secs(120);
+    wait_impacts(&c, id, 1, limit).await;
+
+    signal(&coord.proc, "STOP");
+    tokio::time::sleep(Duration::from_secs(5)).await;
+    signal(&coord.proc, "CONT");
+    let s = c.status(id).await.unwrap();
+    assert_eq!(s.jobs.leased, 1, "the job keeps its lease: {s:?}");
+    let log = w.log_text();
+    assert!(
+        log.contains("unreachable"),
+        "a request timed out during the freeze:\n{log}"
+    );
+    assert!(
+        !log.contains("job dropped") && log.matches("job leased").count() == 1,
+        "the worker kept its job:\n{log}"
+    );
+    assert_alive(&mut [&mut w]);
+
+    let before = wait_impacts(&c, id, s.impacts_done + 1, limit).await;
+    assert!(
+        before.impacts_done < before.impacts_total,
+        "the job must still be running when frozen again"
+    );
+    signal(&coord.proc, "STOP");
+    tokio::time::sleep(Duration::from_secs_f64(lease_s + 2.0)).await;
+    signal(&coord.proc, "CONT");
+    let s = wait_done(&c, id, Duration::from_secs(180)).await;
+    assert_eq!(s.impacts_done, 8);
+    let log = w.log_text();
+    assert!(
+        log.contains("job dropped") && log.contains("409"),
+        "the expired lease was refused with 409:\n{log}"
+    );
+    assert!(
+        log.contains("resumed from checkpoint"),
+        "the job was resumed from its checkpoint:\n{log}"
+    );
+    assert_alive(&mut [&mut w]);
+    assert_matches_grit_run(&c, id, dir.path(), &spec, 8).await;
+}
+
+/// A tmpfs mounted by the test, unmounted on drop.
+struct Mount(PathBuf);
+
+impl Mount {
+    /// Mounts a tmpfs of `size` (a `mount` size such as `16m`) at `dir`; the reason when
+    /// this machine does not allow it.
+    fn tmpfs(dir: &Path, size: &str) -> Result<Mount, String> {
+        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+        let out = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
+            .arg(dir)
+            .output()
+            .map_err(|e| format!("mount: {e}"))?;
+        if !out.status.success() {
+            return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
+        }
+        Ok(Mount(dir.to_path_buf()))
+    }
+}
+
+impl Drop for Mount {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg("-l").arg(&self.0).status();
+    }
+}
+
+/// Writes zeros to `path` until the filesystem refuses; returns the bytes written.
+fn fill(path: &Path) -> u64 {
+    use std::io::Write;
+    let mut f = std::fs::File::create(path).unwrap();
+    let block = vec![0u8; 64 << 10];
+    let mut written = 0;
+    // Bounded: the filesystem is a few MB; stop at 1 GiB whatever happens.
+    while written < 1 << 30 {
+        match f.write(&block) {
+            Ok(0) | Err(_) => break,
+            Ok(n) => written += n as u64,
+        }
+    }
+    let _ = f.sync_all();
+    written
+}
+
+/// The coordinator's database on a small tmpfs that fills up: writes are refused with 503
+/// naming the cause, the workers retry, what was stored stays, and once space is freed the
+/// campaign completes bit for bit. Skips (passing) where the test may not mount a tmpfs.
+#[tokio::test(flavor = "multi_thread")]
+async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    // 16 MB: a fresh write-ahead log stays under SQLite's 4 MB auto-checkpoint before the
+    // disk is filled, so every later write must grow it and finds no space.
+    let mnt = dir.path().join("small-disk");
+    let mount = match Mount::tmpfs(&mnt, "16m") {
+        Ok(m) => m,
+        Err(why) => {
+            eprintln!("skipping the full-disk test: cannot mount a tmpfs here ({why})");
+            return;
+        }
+    };
+    let spec = campaign(1, 6);
+    let coord = start_coordinator_on(
+        &mount.0.join("farm.db"),
+        dir.path(),
+        "a",
+        "127.0.0.1:0",
+        30.0,
+        &[],
+    );
+    let c = submitter(&coord.url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let mut w = worker(dir.path(), &coord.url, "w1", &[]);
+    let limit = Duration::from_secs(120);
+    wait_impacts(&c, id, 2, limit).await;
+    let before = raw_series(&c.results_value(id, true).await.unwrap());
+
+    let filler = mount.0.join("filler");
+    let filled = fill(&filler);
+    assert!(filled > 0, "the filler got no space at all");
+    // The worker's next report (an impact and its checkpoint) needs space.
+    let start = Instant::now();
+    while !(coord.proc.log_text().contains("database or disk is full")
+        && w.log_text().contains("503"))
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(90),
+            "no refused write seen.\ncoordinator:\n{}\nworker:\n{}",
+            coord.proc.log_text(),
+            w.log_text()
+        );
+        tokio::time::sleep(Duration::from_millis(200)).await;
+    }
+    let log = w.log_text();
+    assert!(
+        log.contains("disk is full"),
+        "the 503 names the cause:\n{log}"
+    );
+    assert_alive(&mut [&mut w]);
+    // Reads still work, and what was stored before is unchanged.
+    let during = raw_series(&c.results_value(id, true).await.unwrap());
+    assert_eq!(during.len(), before.len());
+    for ((_, _, a), (_, _, b)) in before.iter().zip(&during) {
+        assert!(
+            b.len() >= a.len() && b[..a.len()] == a[..],
+            "stored impacts changed"
+        );
+    }
+
+    std::fs::remove_file(&filler).unwrap();
+    let s = wait_done(&c, id, Duration::from_secs(180)).await;
+    assert_eq!(s.impacts_done, 6);
+    assert_matches_grit_run(&c, id, dir.path(), &spec, 6).await;
+    if let Ok(out) = Command::new("sqlite3")
+        .arg(mount.0.join("farm.db"))
+        .arg("PRAGMA integrity_check;")
+        .output()
+    {
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            !out.status.success() || text.trim() == "ok",
+            "integrity_check: {text}"
+        );
+    }
+    assert_alive(&mut [&mut w]);
+    // Both processes stop before the tmpfs is unmounted.
+    drop(w);
+    drop(coord);
+    drop(mount);
+}
