@@ -1,4 +1,4 @@
-//! The coordinator's dashboard (issue 6): `GET /` is a self-contained page served without a
+//! The coordinator's dashboard: `GET /` is a self-contained page served without a
 //! token and holding no data; `GET /api/v1/workers` and `GET /api/v1/campaigns/{id}/jobs`
 //! show the workers seen recently and the failed jobs with their errors; headless Chromium,
 //! given the submit token in the URL fragment, renders a campaign a real worker finished, its

@@ -1,4 +1,4 @@
-//! End-to-end tests of the job farm (issue 4): the real `grit` binary as coordinator and
+//! End-to-end tests of the job farm: the real `grit` binary as coordinator and
 //! workers over loopback, a fresh SQLite file per test, and real (coarse) SPH impacts.
 //! Set TEST_LOG=1 to see the processes' logs on failure paths.
 

@@ -671,7 +671,7 @@ mod tests {
     }
 
     #[test]
-    fn issue_example_parses() {
+    fn full_example_parses() {
         let s = parse(
             r#"{"name": "paper", "seed": 7, "angles_deg": [15, 30, 45, 60, 75, 90],
                 "shapes": ["octagon", {"name": "hexagon"}, "square",

@@ -1,4 +1,4 @@
-//! The stability map of issue 5 as one chart of three panels: Courant number against
+//! The stability map (docs/performance.md) as one chart of three panels: Courant number against
 //! hourglass coefficient (eq. 16), and contact stiffness (eqs. 24–25) against the time step for
 //! the seed's contact model and for the plain penetration model (seed Fig. 2b).
 

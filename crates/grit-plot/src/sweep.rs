@@ -1,4 +1,4 @@
-//! The speed–accuracy chart of issue 5: erosion (seed section 4) and the Hertz p0 error
+//! The speed–accuracy chart (docs/performance.md): erosion (seed section 4) and the Hertz p0 error
 //! (eq. 31) of each resolution and variant against its wall time per impact.
 
 use std::path::{Path, PathBuf};
@@ -197,7 +197,7 @@ impl Sweep<'_> {
                 grey,
             )))
             .map_err(de)?
-            .label("issue 2's 5 % bound")
+            .label("5 % bound of the Hertz check")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], grey));
         for (k, v) in self.variants.iter().enumerate() {
             let c = colour(k);

@@ -32,7 +32,7 @@ fn penetration_contact_fails_the_2_percent_bound() {
 
 #[test]
 fn elastic_impact_conserves_momentum_and_energy_at_40_per_side() {
-    // The three bounds, with the seed's filter and hourglass control on: momentum to
+    // The three bounds of docs/design.md#targets, with the seed's filter and hourglass control on: momentum to
     // 1e-8, peak E/E0 at most 1.01, E/E0 after contact within 5 %. 30 per side misses the
     // last by 0.2 % (docs/verification.md §6), so the CI resolution is 40.
     let r = elastic_impact::run(40).unwrap();
@@ -45,7 +45,7 @@ fn elastic_impact_conserves_momentum_and_energy_at_40_per_side() {
 #[test]
 fn elastic_impact_energy_is_conserved_without_the_density_filter() {
     // The seed's filter (eq. 12) is the one large sink of this case; without it the engine
-    // must bring the energy back within the 5% once the disc has left.
+    // must bring the energy back within 5% (docs/design.md#targets) once the disc has left.
     let s = grit_sph::Settings {
         shepard_interval: 0,
         ..Default::default()
