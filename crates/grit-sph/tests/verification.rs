@@ -1,5 +1,5 @@
-//! The verification cases at CI resolution, with the tolerances of the issue; `grit verify`
-//! runs the same code at full resolution.
+//! The verification cases at CI resolution, with the tolerances of docs/design.md#targets;
+//! `grit verify` runs the same code at full resolution.
 
 use grit_sph::verification::{elastic_impact, hertz, hourglass, sliding, slope};
 use grit_sph::{ContactModel, Material};

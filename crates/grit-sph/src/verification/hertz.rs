@@ -41,11 +41,11 @@ pub const STIFFNESS_FACTOR: f64 = 4.0;
 pub const DENSITY_FILTER: u32 = 0;
 /// Bound on the relative error of p0 at the finest spacing (docs/design.md#targets).
 pub const P0_BOUND: f64 = 0.05;
-/// Regression bound on the pressure-profile RMS error over p0 (the issue asks for the value
-/// only; measured 0.03–0.04 at 20–50 particles per radius).
+/// Regression bound on the pressure-profile RMS error over p0 (docs/design.md#targets asks
+/// for the value only; measured 0.03–0.04 at 20–50 particles per radius).
 pub const PRESSURE_RMS_BOUND: f64 = 0.1;
-/// Regression bound on the axis-stress RMS error over p0 (the issue asks for the value only;
-/// measured 0.09–0.11 at 20–50 particles per radius, most of it the finite cylinder's own
+/// Regression bound on the axis-stress RMS error over p0 (docs/design.md#targets asks for
+/// the value only; measured 0.09–0.11 at 20–50 particles per radius, most of it the finite cylinder's own
 /// horizontal tension, which the half-space solution of eq. 33 leaves out).
 pub const AXIS_RMS_BOUND: f64 = 0.15;
 
