@@ -3,8 +3,8 @@
 //! it mechanics or density drift?
 //!
 //! Runs one sample per configuration, impact by impact, and after every `--every`-th impact
-//! writes, per region of free particles (and of the fixed bands; regions picked by the reference position `x_ref`, so
-//! each follows the same material through the sample):
+//! writes, per region of free particles (and of the fixed bands; regions picked by the
+//! reference position `x_ref`, so each follows the same material through the sample):
 //! - the EOS pressure p = K(ρ/ρ0 − 1) (seed eq. 11) and the mean stress −tr σ/3 of the full
 //!   plane-strain Cauchy stress (`grit_sph::vtk::cauchy_stress_3d`), and the in-plane mean
 //!   −(σxx + σyy)/2;
@@ -14,8 +14,8 @@
 //!   least-squares map of each particle's lattice neighbours from `x_ref` to their current
 //!   positions, which depends on positions only.
 //!
-//! ρ − ρ0/det F is what the filter (and step rounding) changed that the motion did not; ρ0/det F
-//! − ρ0/det F_geo is how far the integrated gradient strays from the particle positions.
+//! ρ − ρ0/det F is what the filter (and step rounding) changed that the motion did not;
+//! ρ0/det F − ρ0/det F_geo is how far the integrated gradient strays from the positions.
 //!
 //! ```sh
 //! cargo run --release -p grit-erosion --example stored_compression -- OUT_DIR \
@@ -23,8 +23,9 @@
 //! ```
 //!
 //! With `--probe-steps N` it runs no impacts but takes the surface of `OUT_DIR/<config>.ckpt`
-//! alone (no grain) through one density-filter pass, and through N steps at rest with the filter
-//! and without it, writing `OUT_DIR/probe-<config>-<impact>.csv` (see `probe`).
+//! alone (no grain) through one density-filter pass, and through N steps at rest with the Shepard
+//! filter, without a filter and with the MLS filter, writing
+//! `OUT_DIR/probe-<config>-<impact>.csv` (see `probe`).
 //!
 //! Configurations (45°, hexagon, Δx = 16 µm, aim range 0.5 Dg unless named):
 //! `small` 2.5 × 1.25 Dg; `wide` 3.75 × 1.875 Dg; `wide-r1` the same with aim range 1.0 Dg;
@@ -40,7 +41,7 @@ use std::time::Instant;
 
 use grit_erosion::{ImpactParams, Numerics, Sample, Shape};
 use grit_sph::particles::{von_mises, KINEMATIC};
-use grit_sph::{Matrix, Motion, Particles, Settings, Vector, World};
+use grit_sph::{DensityFilter, Matrix, Motion, Particles, Settings, Vector, World};
 
 const HEADER: &str = "impact,config,region,n,mean_p_eos,mean_p_stress,mean_p_inplane,\
 mean_rho,mean_rho_kin,mean_rho_geo,n_geo,mean_drift,std_drift,mean_abs_drift,mean_kin_geo,\
@@ -87,8 +88,8 @@ fn params(config: &str) -> Result<ImpactParams, String> {
     Ok(p)
 }
 
-/// Least-squares deformation gradient of each particle's lattice neighbours (within 1.5 Δx in
-/// the reference configuration): F = (Σ x_ij X_ijᵀ)(Σ X_ij X_ijᵀ)⁻¹. None where a neighbour
+/// Least-squares deformation gradient of each particle's lattice neighbours (within 1.5 Δx
+/// in the reference configuration): F = (Σ x_ij X_ijᵀ)(Σ X_ij X_ijᵀ)⁻¹. None where a neighbour
 /// is gone (crater, removed particle), since a one-sided fit says little about volume.
 fn geometric_def_grad(p: &Particles, dx: f64) -> Vec<Option<Matrix>> {
     let cell = 1.5 * dx;
@@ -320,8 +321,9 @@ fn rest_world(
 
 /// Separates the density filter's share of the drift from the rest on the surface of
 /// `OUT_DIR/<config>.ckpt`, without a grain: one filter pass on the state as it is, and
-/// `steps` steps of the surface left alone with the filter every 40 steps (the engine default)
-/// and with it off. Writes `OUT_DIR/probe-<config>-<impact>.csv`.
+/// `steps` steps of the surface left alone with the Shepard filter every 40 steps (the engine
+/// default, seed eq. 12), with it off, and with the engine's MLS filter instead. Writes
+/// `OUT_DIR/probe-<config>-<impact>.csv`.
 fn probe(out: &Path, config: &str, steps: u64) -> Result<(), String> {
     let bytes = std::fs::read(out.join(format!("{config}.ckpt"))).map_err(|e| e.to_string())?;
     let sample = Sample::from_checkpoint(&bytes).map_err(|e| e.to_string())?;
@@ -351,9 +353,14 @@ fn probe(out: &Path, config: &str, steps: u64) -> Result<(), String> {
     let mut once = rest_world(&prm, sample.surface(), prm.settings())?;
     once.filter_density();
     push("one_filter", once.particles());
-    for (case, interval) in [("rest_filter", 40), ("rest_nofilter", 0)] {
+    for (case, interval, filter) in [
+        ("rest_filter", 40, DensityFilter::Shepard),
+        ("rest_nofilter", 0, DensityFilter::Shepard),
+        ("rest_mls", 40, DensityFilter::Mls),
+    ] {
         let settings = Settings {
             shepard_interval: interval,
+            density_filter: filter,
             ..prm.settings()
         };
         let mut w = rest_world(&prm, sample.surface(), settings)?;
