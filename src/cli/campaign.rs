@@ -240,6 +240,18 @@ fn warn_unsteady(results: &CampaignResults, all: bool) {
 
 /// Warns of a campaign's unsteady cells from its results, if the coordinator sends them in
 /// a form this grit reads; a status must not fail because the results could not be judged.
+/// The campaign's last job error, if any, as `grit status` prints it.
+fn say_last_error(s: &CampaignStatus) {
+    if let Some(e) = &s.last_error {
+        say!(
+            "last error (cell {}, sample {}): {}",
+            e.cell,
+            e.sample,
+            e.error
+        );
+    }
+}
+
 async fn warn_unsteady_remote(client: &Client, id: Uuid, finished: bool) {
     match client.results_value(id, false).await {
         Ok(v) => match serde_json::from_value::<CampaignResults>(v) {
@@ -345,14 +357,7 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             s.rate_impacts_per_s.map_or("–".into(), |r| format!("{r:.3}/s")),
             fmt_eta(s.eta_s)
         );
-        if let Some(e) = s.last_error {
-            say!(
-                "last error (cell {}, sample {}): {}",
-                e.cell,
-                e.sample,
-                e.error
-            );
-        }
+        say_last_error(&s);
     }
     if s.impacts_done > 0 {
         warn_unsteady_remote(&client, id, s.state.is_final()).await;
@@ -399,14 +404,7 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
             for b in &cells {
                 b.finish();
             }
-            if let Some(e) = s.last_error {
-                say!(
-                    "last error (cell {}, sample {}): {}",
-                    e.cell,
-                    e.sample,
-                    e.error
-                );
-            }
+            say_last_error(&s);
             if s.impacts_done > 0 {
                 warn_unsteady_remote(client, id, true).await;
             }

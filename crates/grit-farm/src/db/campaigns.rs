@@ -5,10 +5,10 @@ use std::collections::BTreeMap;
 
 use grit_erosion::campaign::CampaignSpec;
 use grit_erosion::{aggregate_campaign, Impact, ImpactRecord, SampleInput};
-use sqlx::{QueryBuilder, Row, Sqlite};
+use sqlx::Row;
 use uuid::Uuid;
 
-use super::{now_ms, parse_uuid, Store};
+use super::{insert_queued_jobs, now_ms, parse_uuid, NewJob, Store};
 use crate::api::{
     CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress, JobCounts,
     JobError, JobInfo, JobState, RawSample, ResultsResponse,
@@ -96,9 +96,7 @@ impl Store {
             .execute(&mut *tx)
             .await?;
         }
-        // Multi-row inserts keep a campaign of many thousand jobs to a few statements; 400
-        // rows × 8 values stays under SQLite's limit on bound variables.
-        let jobs: Vec<(u32, u32, u32, u64)> = cells
+        let jobs: Vec<NewJob> = cells
             .iter()
             .flat_map(|c| {
                 (0..samples).map(move |s| {
@@ -111,23 +109,7 @@ impl Store {
                 })
             })
             .collect();
-        for chunk in jobs.chunks(400) {
-            let mut qb = QueryBuilder::<Sqlite>::new(
-                "INSERT INTO jobs (campaign_id, campaign_seq, cell_index, sample_index, seed,
-                                   impacts_planned, state, updated_ms) ",
-            );
-            qb.push_values(chunk, |mut b, (cell, sample, impacts, seed)| {
-                b.push_bind(id.to_string())
-                    .push_bind(seq)
-                    .push_bind(*cell as i64)
-                    .push_bind(*sample as i64)
-                    .push_bind(*seed as i64)
-                    .push_bind(*impacts as i64)
-                    .push_bind("queued")
-                    .push_bind(now);
-            });
-            qb.build().execute(&mut *tx).await?;
-        }
+        insert_queued_jobs(&mut tx, &id.to_string(), seq, &jobs, now).await?;
         tx.commit().await?;
         tracing::info!(campaign = %id, jobs = jobs_total, impacts_total, "campaign created");
         Ok(CampaignCreated {

@@ -8,10 +8,10 @@ use std::collections::BTreeMap;
 
 use grit_erosion::campaign::{job_seed, next_step, CampaignSpec, NextStep, TargetSem, UntilSteady};
 use grit_erosion::{aggregate_cell, CellInput, Impact, SampleInput, SLOPE_WINDOW};
-use sqlx::{QueryBuilder, Row, Sqlite, Transaction};
+use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
-use super::Store;
+use super::{insert_queued_jobs, NewJob, Store};
 use crate::error::{Error, Result};
 
 /// A cell's current plan and the rules that may grow it.
@@ -177,15 +177,11 @@ pub(super) async fn settle_cell(
             .bind(cell)
             .execute(&mut **tx)
             .await?;
-            sqlx::query("UPDATE cells SET impacts = ? WHERE campaign_id = ? AND cell_index = ?")
-                .bind(to as i64)
-                .bind(campaign)
-                .bind(cell)
-                .execute(&mut **tx)
-                .await?;
-            grow_total(
+            grow_cell(
                 tx,
                 campaign,
+                cell,
+                PlanColumn::Impacts(to),
                 (to - plan.impacts) as i64 * plan.samples as i64,
             )
             .await?;
@@ -197,32 +193,15 @@ pub(super) async fn settle_cell(
                 .await?;
             let seq: i64 = r.get(0);
             let seed = CampaignSpec::from_json(&r.get::<String, _>(1))?.seed;
-            let mut qb = QueryBuilder::<Sqlite>::new(
-                "INSERT INTO jobs (campaign_id, campaign_seq, cell_index, sample_index, seed,
-                                   impacts_planned, state, updated_ms) ",
-            );
-            // Samples grow at most to the spec's `max`, which validation bounds by MAX_JOBS;
-            // a few hundred rows per cell stay far under SQLite's bound-variable limit.
-            qb.push_values(plan.samples..to, |mut b, s| {
-                b.push_bind(campaign)
-                    .push_bind(seq)
-                    .push_bind(cell)
-                    .push_bind(s as i64)
-                    .push_bind(job_seed(seed, cell as u32, s) as i64)
-                    .push_bind(plan.impacts as i64)
-                    .push_bind("queued")
-                    .push_bind(now);
-            });
-            qb.build().execute(&mut **tx).await?;
-            sqlx::query("UPDATE cells SET samples = ? WHERE campaign_id = ? AND cell_index = ?")
-                .bind(to as i64)
-                .bind(campaign)
-                .bind(cell)
-                .execute(&mut **tx)
-                .await?;
-            grow_total(
+            let jobs: Vec<NewJob> = (plan.samples..to)
+                .map(|s| (cell as u32, s, plan.impacts, job_seed(seed, cell as u32, s)))
+                .collect();
+            insert_queued_jobs(tx, campaign, seq, &jobs, now).await?;
+            grow_cell(
                 tx,
                 campaign,
+                cell,
+                PlanColumn::Samples(to),
                 (to - plan.samples) as i64 * plan.impacts as i64,
             )
             .await?;
@@ -249,9 +228,38 @@ pub(super) async fn settle_cell(
     Ok(())
 }
 
-async fn grow_total(tx: &mut Transaction<'static, Sqlite>, campaign: &str, by: i64) -> Result<()> {
+/// The cell's new plan: impacts per sample, or samples.
+enum PlanColumn {
+    Impacts(u32),
+    Samples(u32),
+}
+
+/// Records a cell's new plan and adds `added_impacts` to its campaign's total.
+async fn grow_cell(
+    tx: &mut Transaction<'static, Sqlite>,
+    campaign: &str,
+    cell: i64,
+    plan: PlanColumn,
+    added_impacts: i64,
+) -> Result<()> {
+    let (sql, value) = match plan {
+        PlanColumn::Impacts(n) => (
+            "UPDATE cells SET impacts = ? WHERE campaign_id = ? AND cell_index = ?",
+            n,
+        ),
+        PlanColumn::Samples(n) => (
+            "UPDATE cells SET samples = ? WHERE campaign_id = ? AND cell_index = ?",
+            n,
+        ),
+    };
+    sqlx::query(sql)
+        .bind(value as i64)
+        .bind(campaign)
+        .bind(cell)
+        .execute(&mut **tx)
+        .await?;
     sqlx::query("UPDATE campaigns SET impacts_total = impacts_total + ? WHERE id = ?")
-        .bind(by)
+        .bind(added_impacts)
         .bind(campaign)
         .execute(&mut **tx)
         .await?;

@@ -112,3 +112,36 @@ async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool>
 fn parse_uuid(s: &str) -> Result<Uuid> {
     Uuid::from_str(s).map_err(|e| Error::Internal(format!("stored id {s}: {e}")))
 }
+
+/// A job row to insert as queued: (cell, sample, impacts planned, seed).
+pub(crate) type NewJob = (u32, u32, u32, u64);
+
+/// Inserts `jobs` of `campaign` (rowid `seq`) as queued. Multi-row inserts keep a campaign of
+/// many thousand jobs to a few statements; 400 rows × 8 values stays under SQLite's limit on
+/// bound variables.
+pub(crate) async fn insert_queued_jobs(
+    tx: &mut Transaction<'static, Sqlite>,
+    campaign: &str,
+    seq: i64,
+    jobs: &[NewJob],
+    now: i64,
+) -> Result<()> {
+    for chunk in jobs.chunks(400) {
+        let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
+            "INSERT INTO jobs (campaign_id, campaign_seq, cell_index, sample_index, seed,
+                               impacts_planned, state, updated_ms) ",
+        );
+        qb.push_values(chunk, |mut b, (cell, sample, impacts, seed)| {
+            b.push_bind(campaign)
+                .push_bind(seq)
+                .push_bind(*cell as i64)
+                .push_bind(*sample as i64)
+                .push_bind(*seed as i64)
+                .push_bind(*impacts as i64)
+                .push_bind("queued")
+                .push_bind(now);
+        });
+        qb.build().execute(&mut **tx).await?;
+    }
+    Ok(())
+}
