@@ -47,6 +47,12 @@ const HEADER: &str = "impact,config,region,n,mean_p_eos,mean_p_stress,mean_p_inp
 mean_rho,mean_rho_kin,mean_rho_geo,n_geo,mean_drift,std_drift,mean_abs_drift,mean_kin_geo,\
 std_kin_geo,mean_eps_p,mean_vm,n_surface,mass_loss_cum_kg,erosion_mg_g,steps,wall_s";
 
+fn no_filter() -> Numerics {
+    let mut numerics = Numerics::default();
+    numerics.engine.shepard_interval = 0;
+    numerics
+}
+
 fn params(config: &str) -> Result<ImpactParams, String> {
     let base = ImpactParams {
         angle_deg: 45.0,
@@ -76,6 +82,23 @@ fn params(config: &str) -> Result<ImpactParams, String> {
                 absorbing_layers: 4.0,
                 ..Numerics::default()
             },
+            ..base
+        },
+        "small-reset" => ImpactParams {
+            numerics: Numerics {
+                reset_density: true,
+                ..Numerics::default()
+            },
+            ..base
+        },
+        "small-nofilter" => ImpactParams {
+            numerics: no_filter(),
+            ..base
+        },
+        "wide-nofilter" => ImpactParams {
+            surface_width_dg: 3.75,
+            surface_depth_dg: 1.875,
+            numerics: no_filter(),
             ..base
         },
         "shallow" => ImpactParams {

@@ -70,6 +70,10 @@ pub struct Numerics {
     /// Thickness, in particle layers, of an absorbing (sponge) layer just inside the surface's
     /// fixed bottom and side bands; 0 for none (`grit_sph::Absorber`).
     pub absorbing_layers: f64,
+    /// Set every particle's density to ρ0/det F when an impact starts, so that the density
+    /// filter's drift (eq. 12; docs/erosion.md, "Stored compression") does not add up over a
+    /// sample's impacts. F follows the positions, so this is the density they imply.
+    pub reset_density: bool,
 }
 
 impl Default for Numerics {
@@ -84,6 +88,7 @@ impl Default for Numerics {
             contact_stiffness_scale: 1.0,
             skip_flight: true,
             absorbing_layers: 0.0,
+            reset_density: false,
         }
     }
 }
@@ -102,6 +107,16 @@ struct NumericsJson {
     skip_flight: bool,
     cell_order: bool,
     absorbing_layers: f64,
+    // Written only where they differ from the seed, so the scenes stored before these keys
+    // existed keep their bytes, and a missing key reads as the seed's choice.
+    #[serde(skip_serializing_if = "is_seed_interval")]
+    shepard_interval: u32,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    reset_density: bool,
+}
+
+fn is_seed_interval(n: &u32) -> bool {
+    *n == Settings::default().shepard_interval
 }
 
 impl Default for NumericsJson {
@@ -123,6 +138,8 @@ impl From<Numerics> for NumericsJson {
             skip_flight: n.skip_flight,
             cell_order: n.engine.cell_order,
             absorbing_layers: n.absorbing_layers,
+            shepard_interval: n.engine.shepard_interval,
+            reset_density: n.reset_density,
         }
     }
 }
@@ -137,12 +154,14 @@ impl From<NumericsJson> for Numerics {
                 contact_limits_dt: j.contact_limits_dt,
                 rigid_shell: j.grain_shell,
                 cell_order: j.cell_order,
+                shepard_interval: j.shepard_interval,
                 ..Settings::default()
             },
             contact_model: j.contact_model,
             contact_stiffness_scale: j.contact_stiffness_scale,
             skip_flight: j.skip_flight,
             absorbing_layers: j.absorbing_layers,
+            reset_density: j.reset_density,
         }
     }
 }
@@ -494,6 +513,15 @@ pub fn impact_world(
     // Grains arrive milliseconds apart in a blasting test: the surface is at rest and at room
     // temperature again by then (seed section 4), while stress, strain and damage remain.
     state.vel.iter_mut().for_each(|v| *v = Vector::zeros());
+    if params.numerics.reset_density {
+        for ((rho, rho0), f) in state.rho.iter_mut().zip(&state.rho0).zip(&state.def_grad) {
+            let det = f.determinant();
+            // A particle crushed past inversion keeps its density rather than a negative one.
+            if det.is_finite() && det > 0.0 {
+                *rho = rho0 / det;
+            }
+        }
+    }
     let s = world.add_deformable_state("surface", params.material.clone(), state, Motion::Fixed)?;
     world.reset_temperature();
     if let Some(a) = params.absorber() {
@@ -863,5 +891,17 @@ mod tests {
         let n: Numerics = serde_json::from_str(r#"{"cfl": 0.2, "grain_shell": false}"#).unwrap();
         assert_eq!((n.engine.cfl, n.engine.rigid_shell), (0.2, false));
         assert!(serde_json::from_str::<Numerics>(r#"{"h_over_dx": 1.5}"#).is_err());
+    }
+
+    #[test]
+    fn the_density_filter_interval_is_written_only_where_it_is_not_the_seeds() {
+        let mut n = Numerics::default();
+        n.engine.shepard_interval = 0;
+        let json = serde_json::to_string(&n).unwrap();
+        assert!(json.ends_with(r#""absorbing_layers":0.0,"shepard_interval":0}"#), "{json}");
+        assert_eq!(serde_json::from_str::<Numerics>(&json).unwrap(), n);
+        let n: Numerics = serde_json::from_str(r#"{"shepard_interval": 80}"#).unwrap();
+        assert_eq!(n.engine.shepard_interval, 80);
+        assert!(serde_json::from_str::<Numerics>(r#"{"shepard_interval": -1}"#).is_err());
     }
 }

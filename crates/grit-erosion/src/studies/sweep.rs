@@ -31,16 +31,50 @@ pub enum Variant {
     /// The paper's numerics with an absorbing layer of this many particle layers inside the
     /// surface's fixed bands (`Numerics::absorbing_layers`).
     Absorbing(f64),
+    /// The paper's numerics with the density filter (eq. 12) every this many steps instead of
+    /// 40; 0 switches it off.
+    Filter(u32),
+    /// The paper's numerics at another Courant number, with the filter interval in steps scaled
+    /// so that the filter runs as often in simulated time as the seed's 40 steps at CFL 0.3.
+    CflFilterInTime(f64),
+    /// The paper's numerics with every density reset to ρ0/det F when an impact starts
+    /// (`Numerics::reset_density`).
+    ResetDensity,
+}
+
+/// The density-filter interval in steps that keeps the seed's period in simulated time (40
+/// steps at CFL 0.3: the step is proportional to the Courant number).
+pub fn filter_interval_in_time(cfl: f64) -> u32 {
+    let seed = Numerics::default().engine;
+    (seed.shepard_interval as f64 * seed.cfl / cfl).round().max(1.0) as u32
 }
 
 impl Variant {
-    /// Parses `seed`, `wendland_c2`, `full_flight`, `cfl=X` or `absorbing=N`.
+    /// Parses `seed`, `wendland_c2`, `full_flight`, `reset_density`, `cfl=X`, `cfl_time=X`,
+    /// `filter=N` or `absorbing=N`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
             "full_flight" => Ok(Variant::FullFlight),
+            "reset_density" => Ok(Variant::ResetDensity),
+            other if other.starts_with("filter=") => {
+                match other["filter=".len()..].parse::<u32>() {
+                    Ok(n) => Ok(Variant::Filter(n)),
+                    _ => bad(format!(
+                        "`{other}`: the filter interval is a whole number of steps (0 = off)"
+                    )),
+                }
+            }
+            other if other.starts_with("cfl_time=") => {
+                match other["cfl_time=".len()..].parse::<f64>() {
+                    Ok(c) if c > 0.0 && c <= grit_sph::world::MAX_CFL => {
+                        Ok(Variant::CflFilterInTime(c))
+                    }
+                    _ => bad(format!("`{other}`: the Courant number must be in (0, 2]")),
+                }
+            }
             other if other.starts_with("absorbing=") => {
                 match other["absorbing=".len()..].parse::<f64>() {
                     Ok(n) if n.is_finite() && n > 0.0 => Ok(Variant::Absorbing(n)),
@@ -55,7 +89,7 @@ impl Variant {
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X, absorbing=N)"
+                    "unknown variant `{other}` (known: seed, wendland_c2, full_flight, reset_density, cfl=X, cfl_time=X, filter=N, absorbing=N)"
                 )),
             },
         }
@@ -69,6 +103,13 @@ impl Variant {
             Variant::Cfl(c) => format!("CFL {c}"),
             Variant::FullFlight => "seed, flight simulated".into(),
             Variant::Absorbing(n) => format!("seed, absorbing layer of {n} Δx"),
+            Variant::Filter(0) => "seed, no density filter".into(),
+            Variant::Filter(n) => format!("seed, density filter every {n} steps"),
+            Variant::CflFilterInTime(c) => format!(
+                "CFL {c}, density filter every {} steps",
+                filter_interval_in_time(*c)
+            ),
+            Variant::ResetDensity => "seed, density reset per impact".into(),
         }
     }
 
@@ -81,6 +122,12 @@ impl Variant {
             Variant::Cfl(cfl) => n.engine.cfl = cfl,
             Variant::FullFlight => n.skip_flight = false,
             Variant::Absorbing(layers) => n.absorbing_layers = layers,
+            Variant::Filter(every) => n.engine.shepard_interval = every,
+            Variant::CflFilterInTime(cfl) => {
+                n.engine.cfl = cfl;
+                n.engine.shepard_interval = filter_interval_in_time(cfl);
+            }
+            Variant::ResetDensity => n.reset_density = true,
         }
         n
     }
@@ -484,6 +531,16 @@ mod tests {
             .to_string()
             .contains("(0, 2]"));
         assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
+        assert_eq!(Variant::parse("filter=0"), Ok(Variant::Filter(0)));
+        assert!(Variant::parse("filter=-1").is_err());
+        assert_eq!(Variant::parse("reset_density"), Ok(Variant::ResetDensity));
+        assert_eq!(
+            Variant::parse("cfl_time=0.6"),
+            Ok(Variant::CflFilterInTime(0.6))
+        );
+        assert_eq!(filter_interval_in_time(0.6), 20);
+        assert_eq!(filter_interval_in_time(0.45), 27);
+        assert_eq!(filter_interval_in_time(0.3), 40);
         assert!(Variant::parse("absorbing=-1")
             .unwrap_err()
             .to_string()
