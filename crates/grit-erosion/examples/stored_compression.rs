@@ -84,13 +84,6 @@ fn params(config: &str) -> Result<ImpactParams, String> {
             },
             ..base
         },
-        "small-reset" => ImpactParams {
-            numerics: Numerics {
-                reset_density: true,
-                ..Numerics::default()
-            },
-            ..base
-        },
         "small-nofilter" => ImpactParams {
             numerics: no_filter(),
             ..base

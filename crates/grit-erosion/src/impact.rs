@@ -70,10 +70,6 @@ pub struct Numerics {
     /// Thickness, in particle layers, of an absorbing (sponge) layer just inside the surface's
     /// fixed bottom and side bands; 0 for none (`grit_sph::Absorber`).
     pub absorbing_layers: f64,
-    /// Set every particle's density to ρ0/det F when an impact starts, so that the density
-    /// filter's drift (eq. 12; docs/erosion.md, "Stored compression") does not add up over a
-    /// sample's impacts. F follows the positions, so this is the density they imply.
-    pub reset_density: bool,
 }
 
 impl Default for Numerics {
@@ -88,7 +84,6 @@ impl Default for Numerics {
             contact_stiffness_scale: 1.0,
             skip_flight: true,
             absorbing_layers: 0.0,
-            reset_density: false,
         }
     }
 }
@@ -107,12 +102,10 @@ struct NumericsJson {
     skip_flight: bool,
     cell_order: bool,
     absorbing_layers: f64,
-    // Written only where they differ from the seed, so the scenes stored before these keys
-    // existed keep their bytes, and a missing key reads as the seed's choice.
+    // Written only where it differs from the seed's, so the scenes stored before this key
+    // existed keep their bytes.
     #[serde(skip_serializing_if = "is_seed_interval")]
     shepard_interval: u32,
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    reset_density: bool,
 }
 
 fn is_seed_interval(n: &u32) -> bool {
@@ -139,7 +132,6 @@ impl From<Numerics> for NumericsJson {
             cell_order: n.engine.cell_order,
             absorbing_layers: n.absorbing_layers,
             shepard_interval: n.engine.shepard_interval,
-            reset_density: n.reset_density,
         }
     }
 }
@@ -161,7 +153,6 @@ impl From<NumericsJson> for Numerics {
             contact_stiffness_scale: j.contact_stiffness_scale,
             skip_flight: j.skip_flight,
             absorbing_layers: j.absorbing_layers,
-            reset_density: j.reset_density,
         }
     }
 }
@@ -513,15 +504,6 @@ pub fn impact_world(
     // Grains arrive milliseconds apart in a blasting test: the surface is at rest and at room
     // temperature again by then (seed section 4), while stress, strain and damage remain.
     state.vel.iter_mut().for_each(|v| *v = Vector::zeros());
-    if params.numerics.reset_density {
-        for ((rho, rho0), f) in state.rho.iter_mut().zip(&state.rho0).zip(&state.def_grad) {
-            let det = f.determinant();
-            // A particle crushed past inversion keeps its density rather than a negative one.
-            if det.is_finite() && det > 0.0 {
-                *rho = rho0 / det;
-            }
-        }
-    }
     let s = world.add_deformable_state("surface", params.material.clone(), state, Motion::Fixed)?;
     world.reset_temperature();
     if let Some(a) = params.absorber() {

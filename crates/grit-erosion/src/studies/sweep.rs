@@ -37,9 +37,6 @@ pub enum Variant {
     /// The paper's numerics at another Courant number, with the filter interval in steps scaled
     /// so that the filter runs as often in simulated time as the seed's 40 steps at CFL 0.3.
     CflFilterInTime(f64),
-    /// The paper's numerics with every density reset to ρ0/det F when an impact starts
-    /// (`Numerics::reset_density`).
-    ResetDensity,
 }
 
 /// The density-filter interval in steps that keeps the seed's period in simulated time (40
@@ -50,15 +47,14 @@ pub fn filter_interval_in_time(cfl: f64) -> u32 {
 }
 
 impl Variant {
-    /// Parses `seed`, `wendland_c2`, `full_flight`, `reset_density`, `cfl=X`, `cfl_time=X`,
-    /// `filter=N` or `absorbing=N`.
+    /// Parses `seed`, `wendland_c2`, `full_flight`, `cfl=X`, `cfl_time=X`, `filter=N` or
+    /// `absorbing=N`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
             "full_flight" => Ok(Variant::FullFlight),
-            "reset_density" => Ok(Variant::ResetDensity),
             other if other.starts_with("filter=") => {
                 match other["filter=".len()..].parse::<u32>() {
                     Ok(n) => Ok(Variant::Filter(n)),
@@ -89,7 +85,7 @@ impl Variant {
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, wendland_c2, full_flight, reset_density, cfl=X, cfl_time=X, filter=N, absorbing=N)"
+                    "unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N)"
                 )),
             },
         }
@@ -109,7 +105,6 @@ impl Variant {
                 "CFL {c}, density filter every {} steps",
                 filter_interval_in_time(*c)
             ),
-            Variant::ResetDensity => "seed, density reset per impact".into(),
         }
     }
 
@@ -127,7 +122,6 @@ impl Variant {
                 n.engine.cfl = cfl;
                 n.engine.shepard_interval = filter_interval_in_time(cfl);
             }
-            Variant::ResetDensity => n.reset_density = true,
         }
         n
     }
@@ -533,7 +527,6 @@ mod tests {
         assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
         assert_eq!(Variant::parse("filter=0"), Ok(Variant::Filter(0)));
         assert!(Variant::parse("filter=-1").is_err());
-        assert_eq!(Variant::parse("reset_density"), Ok(Variant::ResetDensity));
         assert_eq!(
             Variant::parse("cfl_time=0.6"),
             Ok(Variant::CflFilterInTime(0.6))
