@@ -42,7 +42,7 @@ impl World {
         for c in &mut self.contacts {
             c.spring.push(Vector::zeros());
             c.penetration.push(0.0);
-            if c.touches(body, flags) {
+            if body == c.secondary {
                 c.min_mass = c.min_mass.min(mass);
             }
         }
@@ -442,7 +442,7 @@ impl World {
         let p = &self.particles;
         for c in &mut self.contacts {
             c.min_mass = (0..p.len())
-                .filter(|&i| c.touches(p.body[i] as usize, p.flags[i]))
+                .filter(|&i| p.body[i] as usize == c.secondary)
                 .map(|i| p.mass[i])
                 .fold(f64::INFINITY, f64::min);
         }
