@@ -26,6 +26,7 @@ fn start_coordinator(dir: &Path, max_attempts: u32) -> Coordinator {
         "127.0.0.1:0",
         30.0,
         &["--max-attempts", &attempts],
+        None,
     )
 }
 

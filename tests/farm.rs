@@ -30,6 +30,7 @@ fn coordinator(dir: &Path, listen: &str, lease_ttl_s: f64, tag: &str) -> Coordin
         listen,
         lease_ttl_s,
         &["--max-spec-bytes", "65536"],
+        None,
     )
 }
 

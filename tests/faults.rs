@@ -17,7 +17,7 @@ use uuid::Uuid;
 
 mod common;
 use common::results::{assert_bitwise_equal, grit_run, raw_series};
-use common::{start_coordinator, start_coordinator_on, start_worker, wait_for, Proc, SERIAL};
+use common::{start_coordinator, start_worker, wait_for, Proc, SERIAL};
 
 type Series = Vec<(u64, u64, Vec<ImpactRecord>)>;
 
@@ -96,7 +96,7 @@ async fn coordinator_killed_twice_mid_campaign_loses_and_repeats_nothing() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let spec = campaign(2, 4);
-    let mut coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", 30.0, &[]);
+    let mut coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", 30.0, &[], None);
     let url = coord.url.clone();
     // Workers know the coordinator by URL only, so it comes back on the same address.
     let listen = url.trim_start_matches("http://").to_string();
@@ -115,7 +115,7 @@ async fn coordinator_killed_twice_mid_campaign_loses_and_repeats_nothing() {
         // Long enough for the workers to find it gone and start backing off.
         tokio::time::sleep(Duration::from_secs(2)).await;
         assert_alive(&mut [&mut w1, &mut w2]);
-        coord = start_coordinator(dir.path(), tag, &listen, 30.0, &[]);
+        coord = start_coordinator(dir.path(), tag, &listen, 30.0, &[], None);
         let now = c.status(id).await.unwrap();
         assert!(
             now.impacts_done >= mid.impacts_done,
@@ -149,7 +149,7 @@ async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit()
     // times out after 1 s) yet leaves the lease alive: the last renewal is at most 4 s
     // before the freeze and the next at most 4 s after it.
     let lease_s = 12.0;
-    let coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", lease_s, &[]);
+    let coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", lease_s, &[], None);
     let c = submitter(&coord.url);
     let id = c.submit(&spec, None).await.unwrap().id;
     let mut w = worker(dir.path(), &coord.url, "w1", &["--request-timeout-s", "1"]);
@@ -256,14 +256,8 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
         }
     };
     let spec = campaign(1, 6);
-    let coord = start_coordinator_on(
-        &mount.0.join("farm.db"),
-        dir.path(),
-        "a",
-        "127.0.0.1:0",
-        30.0,
-        &[],
-    );
+    let db = mount.0.join("farm.db");
+    let coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", 30.0, &[], Some(&db));
     let c = submitter(&coord.url);
     let id = c.submit(&spec, None).await.unwrap().id;
     let mut w = worker(dir.path(), &coord.url, "w1", &[]);

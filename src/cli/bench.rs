@@ -66,48 +66,7 @@ enum BenchWhat {
     #[command(
         after_help = "Example: grit bench sweep --ppd 8,16,32 --variants seed,wendland_c2 --out out/sweep"
     )]
-    Sweep {
-        /// Impact angle (degrees).
-        #[arg(long, default_value_t = 45.0)]
-        angle: f64,
-        /// Resolutions, particles per grain diameter, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = vec![8.0, 12.0, 16.0, 24.0, 32.0])]
-        ppd: Vec<f64>,
-        /// Numerical variants, comma-separated: seed (the numerics of Mohseni-Mofidi et al.
-        /// 2022), wendland_c2, full_flight, cfl=X, absorbing=N; the first is the reference.
-        #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
-        variants: Vec<String>,
-        /// Resolutions of the variants after the first (default: all of --ppd).
-        #[arg(long, value_delimiter = ',')]
-        variant_ppd: Vec<f64>,
-        /// Samples per point.
-        #[arg(long, default_value_t = 5)]
-        samples: u32,
-        /// Impacts per sample.
-        #[arg(long, default_value_t = 30)]
-        impacts: u32,
-        /// Seed of sample 0; sample k uses seed + k.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Width of the band of aim points (Dg); the reduced campaign's 0.5 by default.
-        #[arg(long, default_value_t = 0.5)]
-        range_dg: f64,
-        /// Surface width (Dg); the reduced campaign's 2.5 (checked by its domain study).
-        #[arg(long, default_value_t = 2.5)]
-        width_dg: f64,
-        /// Surface depth (Dg); the reduced campaign's 1.25.
-        #[arg(long, default_value_t = 1.25)]
-        depth_dg: f64,
-        /// Output folder.
-        #[arg(long, default_value = "out/sweep")]
-        out: PathBuf,
-        /// Keep the points already in OUT/sweep.json and run only the missing ones.
-        #[arg(long)]
-        resume: bool,
-        /// Threads (default: all cores).
-        #[arg(long)]
-        threads: Option<usize>,
-    },
+    Sweep(SweepArgs),
     /// The stability map: one impact with the Courant number swept against the hourglass
     /// coefficient, and the contact stiffness against the time step for both contact models;
     /// each point stable or with the engine's diagnostic. Writes OUT/stability.{csv,json,png,svg}.
@@ -145,6 +104,76 @@ enum BenchWhat {
         #[arg(long)]
         threads: Option<usize>,
     },
+}
+
+/// The settings of `grit bench sweep`: the study's, where it writes, and its threads.
+#[derive(Debug, clap::Args)]
+pub struct SweepArgs {
+    /// Impact angle (degrees).
+    #[arg(long, default_value_t = 45.0)]
+    angle: f64,
+    /// Resolutions, particles per grain diameter, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![8.0, 12.0, 16.0, 24.0, 32.0])]
+    ppd: Vec<f64>,
+    /// Numerical variants, comma-separated: seed (the numerics of Mohseni-Mofidi et al.
+    /// 2022), wendland_c2, full_flight, cfl=X, absorbing=N; the first is the reference.
+    #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
+    variants: Vec<String>,
+    /// Resolutions of the variants after the first (default: all of --ppd).
+    #[arg(long, value_delimiter = ',')]
+    variant_ppd: Vec<f64>,
+    /// Samples per point.
+    #[arg(long, default_value_t = 5)]
+    samples: u32,
+    /// Impacts per sample.
+    #[arg(long, default_value_t = 30)]
+    impacts: u32,
+    /// Seed of sample 0; sample k uses seed + k.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Width of the band of aim points (Dg); the reduced campaign's 0.5 by default.
+    #[arg(long, default_value_t = 0.5)]
+    range_dg: f64,
+    /// Surface width (Dg); the reduced campaign's 2.5 (checked by its domain study).
+    #[arg(long, default_value_t = 2.5)]
+    width_dg: f64,
+    /// Surface depth (Dg); the reduced campaign's 1.25.
+    #[arg(long, default_value_t = 1.25)]
+    depth_dg: f64,
+    /// Output folder.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+    /// Keep the points already in OUT/sweep.json and run only the missing ones.
+    #[arg(long)]
+    resume: bool,
+    /// Threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+impl SweepArgs {
+    /// The study these settings describe: the reduced campaign's scene at `angle`.
+    fn study(&self) -> anyhow::Result<SweepStudy> {
+        let variants = self
+            .variants
+            .iter()
+            .map(|v| Variant::parse(v))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(SweepStudy {
+            params: ImpactParams {
+                distribution_range_dg: self.range_dg,
+                surface_width_dg: self.width_dg,
+                surface_depth_dg: self.depth_dg,
+                ..studies::scene(self.angle, 8e-6)
+            },
+            ppd: self.ppd.clone(),
+            variants,
+            variant_ppd: self.variant_ppd.clone(),
+            samples: self.samples,
+            impacts: self.impacts,
+            seed: self.seed,
+        })
+    }
 }
 
 /// The scene `grit bench impact` times: the reference scene, or a variant of it.
@@ -194,40 +223,9 @@ pub fn run(a: BenchArgs) -> anyhow::Result<ExitCode> {
             repeat,
             json,
         } => impact(scene, threads, repeat, json),
-        BenchWhat::Sweep {
-            angle,
-            ppd,
-            variants,
-            variant_ppd,
-            samples,
-            impacts,
-            seed,
-            range_dg,
-            width_dg,
-            depth_dg,
-            out,
-            resume,
-            threads,
-        } => {
-            let variants = variants
-                .iter()
-                .map(|v| Variant::parse(v))
-                .collect::<Result<Vec<_>, _>>()?;
-            let study = SweepStudy {
-                params: ImpactParams {
-                    distribution_range_dg: range_dg,
-                    surface_width_dg: width_dg,
-                    surface_depth_dg: depth_dg,
-                    ..studies::scene(angle, 8e-6)
-                },
-                ppd,
-                variants,
-                variant_ppd,
-                samples,
-                impacts,
-                seed,
-            };
-            pool(threads)?.install(|| sweep(&study, &out, resume))
+        BenchWhat::Sweep(a) => {
+            let study = a.study()?;
+            pool(a.threads)?.install(|| sweep(&study, &a.out, a.resume))
         }
         BenchWhat::Stability {
             angle,

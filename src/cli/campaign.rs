@@ -45,7 +45,7 @@ pub struct RunArgs {
     pub raw: bool,
 }
 
-/// Where the coordinator is and how to authenticate, for client commands.
+/// Where the coordinator is and how to authenticate: the client commands and `grit work`.
 #[derive(Args, Debug)]
 pub struct Remote {
     /// Coordinator base URL.
@@ -55,7 +55,7 @@ pub struct Remote {
         default_value = "http://127.0.0.1:8080"
     )]
     pub coordinator: String,
-    /// Submit token.
+    /// Submit token (client commands) or worker token (`grit work`).
     #[arg(long, env = "GRIT_TOKEN", hide_env_values = true)]
     pub token: Option<String>,
     /// File holding the token.

@@ -12,6 +12,7 @@ use grit_farm::server::{self, Config};
 use grit_farm::worker::{self, Stop, WorkerOptions};
 use grit_farm::{Client, Store};
 
+use super::campaign::Remote;
 use super::output::say;
 use super::{on_signals, read_token};
 
@@ -58,19 +59,8 @@ pub struct ServeArgs {
 /// `grit work`.
 #[derive(Args, Debug)]
 pub struct WorkArgs {
-    /// Coordinator base URL.
-    #[arg(
-        long,
-        env = "GRIT_COORDINATOR",
-        default_value = "http://127.0.0.1:8080"
-    )]
-    pub coordinator: String,
-    /// Worker token.
-    #[arg(long, env = "GRIT_TOKEN", hide_env_values = true)]
-    pub token: Option<String>,
-    /// File holding the worker token.
-    #[arg(long, env = "GRIT_TOKEN_FILE")]
-    pub token_file: Option<PathBuf>,
+    #[command(flatten)]
+    pub remote: Remote,
     /// Engine threads (rayon pool size); default all cores.
     #[arg(long, env = "GRIT_THREADS")]
     pub threads: Option<usize>,
@@ -140,7 +130,7 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
 
 /// `grit work`: leases and runs jobs until stopped (or idle with `--exit-when-idle`).
 pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
-    let token = read_token(a.token, a.token_file, "token")?;
+    let token = read_token(a.remote.token, a.remote.token_file, "token")?;
     if !(a.request_timeout_s.is_finite() && a.request_timeout_s > 0.0) {
         bail!(
             "--request-timeout-s must be > 0, got {}",
@@ -148,7 +138,7 @@ pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let client = Client::with_timeout(
-        &a.coordinator,
+        &a.remote.coordinator,
         token,
         Duration::from_secs_f64(a.request_timeout_s),
     )?;

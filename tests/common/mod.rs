@@ -64,32 +64,22 @@ pub struct Coordinator {
     pub url: String,
 }
 
-/// `grit serve` on `dir/farm.db` at `listen` with the test tokens, a lease of `lease_ttl_s`
-/// and `extra` flags, logging to `dir/coordinator-{tag}.log`.
+/// `grit serve` at `listen` with the test tokens, a lease of `lease_ttl_s` and `extra` flags,
+/// logging to `dir/coordinator-{tag}.log`; its database is `db`, which may lie on another
+/// filesystem than the log, or else `dir/farm.db`.
 pub fn start_coordinator(
     dir: &Path,
     tag: &str,
     listen: &str,
     lease_ttl_s: f64,
     extra: &[&str],
+    db: Option<&Path>,
 ) -> Coordinator {
-    start_coordinator_on(&dir.join("farm.db"), dir, tag, listen, lease_ttl_s, extra)
-}
-
-/// `start_coordinator` with the database at `db`, which may lie on another filesystem than
-/// the log in `dir`.
-pub fn start_coordinator_on(
-    db: &Path,
-    dir: &Path,
-    tag: &str,
-    listen: &str,
-    lease_ttl_s: f64,
-    extra: &[&str],
-) -> Coordinator {
+    let db = db.map_or_else(|| dir.join("farm.db"), Path::to_path_buf);
     let log = dir.join(format!("coordinator-{tag}.log"));
     let mut child = Command::new(GRIT)
         .args(["serve", "--db"])
-        .arg(db)
+        .arg(&db)
         .args([
             "--listen",
             listen,

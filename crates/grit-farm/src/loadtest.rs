@@ -190,23 +190,7 @@ async fn client_loop(client: Client, name: String, deadline: Instant) -> Tally {
             continue;
         }
         t.heartbeat_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        let record = ImpactRecord {
-            impact: 1,
-            grain_mass_kg: job.params.grain_mass_kg_m(),
-            mass_loss_kg: 0.0,
-            orientation_rad: 0.0,
-            aim_x_m: 0.0,
-            outcome: ImpactOutcome {
-                mass_loss_kg: 0.0,
-                removed_particles: 0,
-                detached_kg: 0.0,
-                detached_particles: 0,
-                sim_time_s: 0.0,
-                steps: 0,
-                rebound_ratio: 0.0,
-                settled: true,
-            },
-        };
+        let record = placeholder_record(1, job.params.grain_mass_kg_m(), 0.0);
         let done = client
             .complete(
                 job.job_id,
@@ -245,4 +229,31 @@ pub fn table(rows: &[LoadTestRow]) -> String {
         ));
     }
     s
+}
+
+/// Impact `impact` as a worker would report it, with no simulation behind it: a grain of
+/// `grain_mass_kg` removing `mass_loss_kg`, settled at once. The load test's jobs and the
+/// store's tests report these.
+pub(crate) fn placeholder_record(
+    impact: u32,
+    grain_mass_kg: f64,
+    mass_loss_kg: f64,
+) -> ImpactRecord {
+    ImpactRecord {
+        impact,
+        grain_mass_kg,
+        mass_loss_kg,
+        orientation_rad: 0.0,
+        aim_x_m: 0.0,
+        outcome: ImpactOutcome {
+            mass_loss_kg,
+            removed_particles: 0,
+            detached_kg: 0.0,
+            detached_particles: 0,
+            sim_time_s: 0.0,
+            steps: 0,
+            rebound_ratio: 0.0,
+            settled: true,
+        },
+    }
 }

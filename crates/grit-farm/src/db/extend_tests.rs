@@ -5,12 +5,13 @@ use std::path::Path;
 use std::time::Duration;
 
 use grit_erosion::campaign::{job_seed, CampaignSpec};
-use grit_erosion::{ImpactOutcome, ImpactRecord};
+use grit_erosion::ImpactRecord;
 use sqlx::Row;
 use uuid::Uuid;
 
 use super::Store;
 use crate::api::{CampaignState, Checkpoint, ClaimedJob};
+use crate::loadtest::placeholder_record;
 
 async fn store(dir: &Path) -> Store {
     Store::open(&dir.join("t.db"), Duration::from_secs(60), 2)
@@ -28,23 +29,7 @@ fn spec(impacts: &str, samples: &str) -> CampaignSpec {
 
 /// Impact `k` (1-based) of a sample losing `loss(k)` × its grain mass.
 fn record(k: u32, loss: f64) -> ImpactRecord {
-    ImpactRecord {
-        impact: k,
-        grain_mass_kg: 1e-4,
-        mass_loss_kg: loss * 1e-4,
-        orientation_rad: 0.0,
-        aim_x_m: 0.0,
-        outcome: ImpactOutcome {
-            mass_loss_kg: loss * 1e-4,
-            removed_particles: 0,
-            detached_kg: 0.0,
-            detached_particles: 0,
-            sim_time_s: 0.0,
-            steps: 0,
-            rebound_ratio: 0.0,
-            settled: true,
-        },
-    }
+    placeholder_record(k, 1e-4, loss * 1e-4)
 }
 
 /// A stand-in for the sample's state after its last impact.
