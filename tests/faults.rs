@@ -1,8 +1,9 @@
 //! Faults a shared cluster throws at the farm, end to end with the real `grit` binary over
 //! loopback and a fresh database per test: the coordinator killed with `kill -9` and
 //! restarted on its database, the coordinator frozen (`SIGSTOP`) past a worker's request
-//! timeout and past the lease, and the coordinator's disk filling up. Each campaign must
-//! still complete with impact records bit-equal to `grit run`'s, each impact stored once.
+//! timeout and past the lease, the coordinator's disk filling up, and checkpoint uploads cut
+//! short, damaged or sent for the wrong job. Each campaign must still complete with impact
+//! records bit-equal to `grit run`'s, each impact stored once.
 //! docs/operations.md describes what an operator sees and does in each case.
 //! Set TEST_LOG=1 to see the processes' logs.
 
@@ -10,14 +11,15 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use grit_erosion::ImpactRecord;
-use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_erosion::{ImpactRecord, Sample};
+use grit_farm::api::{CampaignState, CampaignStatus, Checkpoint, HeartbeatRequest, ReleaseRequest};
 use grit_farm::{Client, Secret};
+use serde_json::json;
 use uuid::Uuid;
 
 mod common;
 use common::results::{assert_bitwise_equal, grit_run, raw_series};
-use common::{start_coordinator, start_worker, wait_for, Proc, SERIAL};
+use common::{start_coordinator, start_worker, wait_for, Api, Proc, SERIAL, WORKER};
 
 type Series = Vec<(u64, u64, Vec<ImpactRecord>)>;
 
@@ -317,4 +319,168 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
     drop(w);
     drop(coord);
     drop(mount);
+}
+
+/// An envelope of `bytes` for job `job` that keeps `meant`'s length and checksum, as when
+/// the bytes were damaged on the way.
+fn damaged(job: i64, meant: &Checkpoint, bytes: &[u8]) -> Checkpoint {
+    Checkpoint {
+        size_bytes: meant.size_bytes,
+        sha256: meant.sha256.clone(),
+        ..Checkpoint::from_bytes(job, meant.impacts_done, bytes)
+    }
+}
+
+/// Checkpoint uploads cut short, with a flipped byte, or meant for another job, each sent by
+/// the lease holder with the next impact: each is refused with a 422 naming the problem and
+/// nothing of its request is stored. The next claim of the job hands out its last good
+/// checkpoint, a worker resumes from it, and the records equal `grit run`'s.
+#[tokio::test(flavor = "multi_thread")]
+async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = campaign(2, 3);
+    let coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", 60.0, &[], None);
+    let c = submitter(&coord.url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let wc = Client::new(&coord.url, Secret::new(Some(WORKER.into()))).unwrap();
+    let a = wc.claim("tester").await.unwrap().expect("job a");
+    let b = wc.claim("tester").await.unwrap().expect("job b");
+    assert_ne!(a.job_id, b.job_id);
+
+    // Job a's first two impacts, run here; the first is reported with its checkpoint.
+    let (params, seed) = (a.params.clone(), a.seed);
+    let (one, two) = tokio::task::spawn_blocking(move || {
+        let mut s = Sample::new(params, seed).unwrap();
+        s.run_next().unwrap();
+        let one = s.clone();
+        s.run_next().unwrap();
+        (one, s)
+    })
+    .await
+    .unwrap();
+    let good = Checkpoint::of_sample(a.job_id, &one);
+    let hb = HeartbeatRequest {
+        lease_id: a.lease_id,
+        impacts: one.records().to_vec(),
+        checkpoint: Some(good.clone()),
+    };
+    assert_eq!(wc.heartbeat(a.job_id, &hb).await.unwrap().impacts_done, 1);
+
+    let bytes = two.checkpoint();
+    let next = Checkpoint::of_sample(a.job_id, &two);
+    let half = &bytes[..bytes.len() / 2];
+    let mut flipped = bytes.clone();
+    flipped[bytes.len() / 2] ^= 0x10;
+    let b_bytes = Sample::new(b.params.clone(), b.seed).unwrap().checkpoint();
+    let uploads = [
+        (
+            "cut short in transit",
+            damaged(a.job_id, &next, half),
+            "checkpoint.data_b64",
+            format!(
+                "checkpoint truncated: {} of its {} bytes arrived",
+                half.len(),
+                bytes.len()
+            ),
+        ),
+        (
+            "cut short before its checksum was taken",
+            Checkpoint::from_bytes(a.job_id, 2, half),
+            "checkpoint.data_b64",
+            "checkpoint: truncated".into(),
+        ),
+        (
+            "a flipped byte",
+            damaged(a.job_id, &next, &flipped),
+            "checkpoint.sha256",
+            "checkpoint checksum mismatch".into(),
+        ),
+        (
+            "job b's checkpoint",
+            Checkpoint::from_bytes(b.job_id, 0, &b_bytes),
+            "checkpoint.job_id",
+            format!(
+                "the checkpoint belongs to job {}, not job {}",
+                b.job_id, a.job_id
+            ),
+        ),
+        (
+            "job b's bytes labelled as job a's",
+            Checkpoint::from_bytes(a.job_id, 0, &b_bytes),
+            "checkpoint.data_b64",
+            "belongs to another job".into(),
+        ),
+    ];
+    let api = Api::new(&coord.url);
+    for (what, ckpt, field, says) in &uploads {
+        let body = json!({
+            "lease_id": a.lease_id,
+            "impacts": [two.records()[1]],
+            "checkpoint": ckpt,
+        });
+        let path = format!("/worker/jobs/{}/heartbeat", a.job_id);
+        let (status, answer) = api.post(&path, WORKER, &body).await;
+        assert_eq!(status, 422, "{what}: {answer}");
+        assert_eq!(answer["field"], *field, "{what}: {answer}");
+        let error = answer["error"].as_str().unwrap();
+        assert!(error.contains(says.as_str()), "{what}: {error}");
+        // Nothing of the request was stored: not its impact either.
+        let s = c.status(id).await.unwrap();
+        assert_eq!(s.impacts_done, 1, "{what}: {s:?}");
+    }
+    // A release with a bad checkpoint is refused too, and the job stays leased.
+    let (status, answer) = api
+        .post(
+            &format!("/worker/jobs/{}/release", a.job_id),
+            WORKER,
+            &json!({"lease_id": a.lease_id, "checkpoint": uploads[2].1}),
+        )
+        .await;
+    assert_eq!(
+        (status, answer["field"].as_str()),
+        (422, Some("checkpoint.sha256"))
+    );
+    assert_eq!(c.status(id).await.unwrap().jobs.leased, 2);
+    assert!(
+        coord.proc.log_text().contains("checkpoint refused"),
+        "{}",
+        coord.proc.log_text()
+    );
+
+    // Both jobs back to the queue; the next claim of job a hands out its last good checkpoint.
+    for (job, lease) in [(a.job_id, a.lease_id), (b.job_id, b.lease_id)] {
+        let back = ReleaseRequest {
+            lease_id: lease,
+            impacts: vec![],
+            checkpoint: None,
+        };
+        wc.release(job, &back).await.unwrap();
+    }
+    let again = wc.claim("tester").await.unwrap().expect("job a again");
+    assert_eq!(again.job_id, a.job_id);
+    assert_eq!(again.impacts_done, 1);
+    let handed = again.checkpoint.clone().expect("a checkpoint");
+    assert_eq!(
+        serde_json::to_value(&handed).unwrap(),
+        serde_json::to_value(&good).unwrap(),
+        "the last good checkpoint is handed out"
+    );
+    let back = ReleaseRequest {
+        lease_id: again.lease_id,
+        impacts: vec![],
+        checkpoint: None,
+    };
+    wc.release(a.job_id, &back).await.unwrap();
+
+    let w = worker(dir.path(), &coord.url, "w1", &[]);
+    let s = wait_done(&c, id, Duration::from_secs(180)).await;
+    assert_eq!(s.impacts_done, 6);
+    let log = w.log_text();
+    assert!(
+        log.contains("resumed from checkpoint"),
+        "job a resumed from its checkpoint:\n{log}"
+    );
+    assert!(!log.contains("checkpoint unusable"), "{log}");
+    assert_matches_grit_run(&c, id, dir.path(), &spec, 3).await;
 }

@@ -220,8 +220,14 @@ impl Sample {
     /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them (for
     /// replaying a job's checkpoint by hand; the farm uses `resume`).
     pub fn from_checkpoint(bytes: &[u8]) -> Result<Sample, SampleError> {
-        let c: Checkpoint = postcard::from_bytes(bytes)
-            .map_err(|e| SampleError::Checkpoint(format!("cannot decode: {e}")))?;
+        let c: Checkpoint = postcard::from_bytes(bytes).map_err(|e| {
+            SampleError::Checkpoint(match e {
+                postcard::Error::DeserializeUnexpectedEnd => {
+                    "truncated: the bytes end before the checkpoint does".into()
+                }
+                e => format!("cannot decode: {e}"),
+            })
+        })?;
         if c.version != CHECKPOINT_VERSION {
             return Err(SampleError::Checkpoint(format!(
                 "version {} but this build reads {CHECKPOINT_VERSION}",

@@ -307,12 +307,19 @@ pub struct ClaimRequest {
     pub worker: String,
 }
 
-/// A checkpoint of a sample's surface after `impacts_done` impacts.
+/// A checkpoint of a sample's surface after `impacts_done` impacts, with the job it belongs
+/// to, its length and its checksum; `grit_farm::checkpoint::verify` checks all of them.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Checkpoint {
+    /// The job whose sample this is.
+    pub job_id: i64,
     /// Impacts the checkpoint contains.
     pub impacts_done: u32,
+    /// Length of the checkpoint bytes (before base64): fewer bytes mean it was cut short.
+    pub size_bytes: u64,
+    /// SHA-256 of the checkpoint bytes (before base64), 64 hexadecimal digits.
+    pub sha256: String,
     /// `grit_erosion::Sample::checkpoint` bytes, base64 (standard alphabet, padded).
     pub data_b64: String,
 }

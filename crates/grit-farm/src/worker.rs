@@ -7,12 +7,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use base64::Engine;
 use grit_erosion::{ImpactRecord, Sample};
 
 use crate::api::{
     Checkpoint, ClaimedJob, CompleteRequest, FailRequest, HeartbeatRequest, ReleaseRequest,
 };
+use crate::checkpoint::verify;
 use crate::client::{Client, ClientError};
 
 /// A stop request shared by a signal handler, the async loop and the engine's cancel callback.
@@ -194,23 +194,13 @@ pub async fn run(
     Ok(r.summary)
 }
 
-fn encode(sample: &Sample) -> Checkpoint {
-    Checkpoint {
-        impacts_done: sample.impacts_done(),
-        data_b64: base64::engine::general_purpose::STANDARD.encode(sample.checkpoint()),
-    }
-}
-
 impl Runner {
-    /// The sample to continue: from the checkpoint when it can be read, else from scratch
-    /// (impacts the coordinator already has are re-run and skipped by it, bit-identical).
+    /// The sample to continue: from the checkpoint when it passes `checkpoint::verify` (its
+    /// job, length, checksum and decoding), else from scratch (impacts the coordinator already
+    /// has are re-run and skipped by it, bit-identical).
     fn open_sample(job: &ClaimedJob) -> Result<Sample, String> {
         if let Some(c) = &job.checkpoint {
-            let resumed = base64::engine::general_purpose::STANDARD
-                .decode(&c.data_b64)
-                .map_err(|e| e.to_string())
-                .and_then(|b| Sample::resume(&job.params, job.seed, &b).map_err(|e| e.to_string()));
-            match resumed {
+            match verify(c, job.job_id, &job.params, job.seed) {
                 Ok(s) => {
                     tracing::info!(
                         job = job.job_id,
@@ -305,14 +295,16 @@ impl Runner {
             {
                 checkpoint_due = true;
             }
-            let ckpt = checkpoint_due.then(|| encode(&sample));
+            let ckpt = checkpoint_due.then(|| Checkpoint::of_sample(job.job_id, &sample));
             match self.heartbeat(&job, &mut pending, ckpt).await {
                 Ok(()) => checkpoint_due = false,
                 Err(Some(why)) => return JobEnd::Lost(why),
                 Err(None) => {}
             }
         }
-        let last = job.extendable.then(|| encode(&sample));
+        let last = job
+            .extendable
+            .then(|| Checkpoint::of_sample(job.job_id, &sample));
         self.complete(&job, pending, last).await
     }
 
@@ -415,7 +407,7 @@ impl Runner {
         let req = ReleaseRequest {
             lease_id: job.lease_id,
             impacts: pending,
-            checkpoint: Some(encode(sample)),
+            checkpoint: Some(Checkpoint::of_sample(job.job_id, sample)),
         };
         match self
             .deliver("release", || self.client.release(job.job_id, &req))
@@ -431,5 +423,64 @@ impl Runner {
             }
         }
         JobEnd::Stopped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! A worker resumes only from a checkpoint that passes the check; a damaged one (bytes
+    //! changed at rest, so they no longer match the stored checksum) starts the sample again.
+
+    use base64::Engine;
+    use grit_erosion::ImpactParams;
+    use uuid::Uuid;
+
+    use super::*;
+
+    fn job(sample: &Sample, checkpoint: Option<Checkpoint>) -> ClaimedJob {
+        ClaimedJob {
+            job_id: 4,
+            lease_id: Uuid::nil(),
+            lease_ttl_s: 60.0,
+            campaign_id: Uuid::nil(),
+            cell: 0,
+            sample: 0,
+            seed: sample.seed(),
+            impacts_planned: 3,
+            impacts_done: sample.impacts_done(),
+            params: sample.params().clone(),
+            extendable: false,
+            checkpoint,
+        }
+    }
+
+    #[test]
+    fn damaged_checkpoint_starts_the_sample_again() {
+        let params = ImpactParams {
+            spacing_m: 40e-6,
+            surface_width_dg: 2.0,
+            surface_depth_dg: 2.0,
+            distribution_range_dg: 0.0,
+            ..ImpactParams::default()
+        };
+        let mut sample = Sample::new(params, 9).unwrap();
+        sample.run_next().unwrap();
+        let good = Checkpoint::of_sample(4, &sample);
+        let resumed = Runner::open_sample(&job(&sample, Some(good.clone()))).unwrap();
+        assert_eq!(resumed.impacts_done(), 1);
+        assert_eq!(resumed.checkpoint(), sample.checkpoint());
+
+        let mut bytes = sample.checkpoint();
+        let last = bytes.len() - 1;
+        bytes[last] ^= 1;
+        let damaged = Checkpoint {
+            data_b64: base64::engine::general_purpose::STANDARD.encode(&bytes),
+            ..good.clone()
+        };
+        let fresh = Runner::open_sample(&job(&sample, Some(damaged))).unwrap();
+        assert_eq!(fresh.impacts_done(), 0);
+        let other_job = Checkpoint { job_id: 5, ..good };
+        let fresh = Runner::open_sample(&job(&sample, Some(other_job))).unwrap();
+        assert_eq!(fresh.impacts_done(), 0);
     }
 }

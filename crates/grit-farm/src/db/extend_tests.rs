@@ -34,10 +34,7 @@ fn record(k: u32, loss: f64) -> ImpactRecord {
 
 /// A stand-in for the sample's state after its last impact.
 fn checkpoint(j: &ClaimedJob) -> Checkpoint {
-    Checkpoint {
-        impacts_done: j.impacts_planned,
-        data_b64: "AAAA".into(),
-    }
+    Checkpoint::from_bytes(j.job_id, j.impacts_planned, &[0; 3])
 }
 
 /// Claims the next job and completes it with impacts lost at `loss(sample, k)`, sending a

@@ -17,6 +17,7 @@ use uuid::Uuid;
 use crate::error::{Error, Result};
 
 mod campaigns;
+mod checkpoints;
 mod extend;
 mod worker;
 mod workers;

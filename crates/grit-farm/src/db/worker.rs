@@ -20,6 +20,8 @@ const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 struct StoredCheckpoint {
     impacts_done: u32,
     data: Vec<u8>,
+    /// `None` for a checkpoint stored before checksums were.
+    sha256: Option<String>,
 }
 
 /// A lease holder's write so far, in its still open transaction.
@@ -128,9 +130,14 @@ impl Store {
             impacts_done: r.get::<i64, _>("impacts_done") as u32,
             params,
             extendable,
-            checkpoint: ckpt.map(|c| Checkpoint {
-                impacts_done: c.impacts_done,
-                data_b64: base64::engine::general_purpose::STANDARD.encode(c.data),
+            checkpoint: ckpt.map(|c| {
+                let mut out = Checkpoint::from_bytes(job_id, c.impacts_done, &c.data);
+                // The stored checksum, not one of the bytes as read now, so the worker
+                // notices bytes damaged at rest.
+                if let Some(sha) = c.sha256 {
+                    out.sha256 = sha;
+                }
+                out
             }),
         }))
     }
@@ -432,15 +439,18 @@ async fn store_checkpoint(
     let data = base64::engine::general_purpose::STANDARD
         .decode(&c.data_b64)
         .map_err(|e| Error::invalid("checkpoint.data_b64", format!("not base64: {e}")))?;
+    let sha256 = crate::checkpoint::sha256_hex(&data);
     sqlx::query(
-        "INSERT INTO checkpoints (job_id, impacts_done, data, updated_ms) VALUES (?, ?, ?, ?)
+        "INSERT INTO checkpoints (job_id, impacts_done, data, sha256, updated_ms)
+         VALUES (?, ?, ?, ?, ?)
          ON CONFLICT (job_id) DO UPDATE SET impacts_done = excluded.impacts_done,
-             data = excluded.data, updated_ms = excluded.updated_ms
+             data = excluded.data, sha256 = excluded.sha256, updated_ms = excluded.updated_ms
          WHERE excluded.impacts_done >= checkpoints.impacts_done",
     )
     .bind(job_id)
     .bind(c.impacts_done as i64)
     .bind(data)
+    .bind(sha256)
     .bind(now)
     .execute(&mut **tx)
     .await?;
@@ -452,13 +462,14 @@ async fn load_checkpoint(
     job_id: i64,
 ) -> Result<Option<StoredCheckpoint>> {
     Ok(
-        sqlx::query("SELECT impacts_done, data FROM checkpoints WHERE job_id = ?")
+        sqlx::query("SELECT impacts_done, data, sha256 FROM checkpoints WHERE job_id = ?")
             .bind(job_id)
             .fetch_optional(&mut **tx)
             .await?
             .map(|r| StoredCheckpoint {
                 impacts_done: r.get::<i64, _>(0) as u32,
                 data: r.get(1),
+                sha256: r.get(2),
             }),
     )
 }

@@ -1,5 +1,7 @@
 //! The endpoints workers call, under the worker token: claim a lease, then heartbeat (with
-//! impacts and checkpoints), complete, fail or release the job it holds.
+//! impacts and checkpoints), complete, fail or release the job it holds. A checkpoint is
+//! verified (`crate::checkpoint::verify`) before the store sees the request, so a refused one
+//! leaves nothing of its request stored, impacts included.
 
 use axum::extract::{FromRequest, Path, Request, State};
 use axum::http::StatusCode;
@@ -9,6 +11,7 @@ use axum::{Json, Router};
 
 use super::AppState;
 use crate::api::*;
+use crate::checkpoint::verify;
 use crate::error::{Error, Result};
 
 /// The worker routes, relative to `/api/v1`.
@@ -25,6 +28,11 @@ pub fn router() -> Router<AppState> {
 #[derive(utoipa::OpenApi)]
 #[openapi(paths(claim, heartbeat, complete, fail, release))]
 pub struct Doc;
+
+/// What a 422 to a request with a checkpoint may mean, for the OpenAPI document.
+const CHECKPOINT_422: &str = "a value breaking a rule, `field` naming it; a checkpoint that is not this job's \
+(`checkpoint.job_id`), cut short (`checkpoint truncated`), damaged (`checkpoint checksum mismatch`) or \
+not a checkpoint of this job's scene and seed: nothing of the request was stored, impacts included";
 
 /// JSON body extractor whose rejections use the API's error body (status kept: 400 for
 /// syntax, 422 naming the field for a wrong value, 413 for too large, 415 for no JSON type).
@@ -48,6 +56,29 @@ where
     }
 }
 
+/// Refuses `checkpoint` with a 422 naming the field at fault unless it is intact and job
+/// `job_id`'s own (`crate::checkpoint::verify`); 404 for an unknown job.
+async fn check_checkpoint(
+    s: &AppState,
+    job_id: i64,
+    checkpoint: Option<&Checkpoint>,
+) -> Result<()> {
+    let Some(c) = checkpoint else {
+        return Ok(());
+    };
+    let (params, seed) = s.store.job_scene(job_id).await?;
+    let c = c.clone();
+    // Decoding a checkpoint of a large surface takes milliseconds: off the async threads.
+    let checked =
+        tokio::task::spawn_blocking(move || verify(&c, job_id, &params, seed).map(|_| ()))
+            .await
+            .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
+    checked.map_err(|e| {
+        tracing::warn!(job = job_id, error = %e, "checkpoint refused; nothing of the request stored");
+        Error::invalid(e.field, e.rule)
+    })
+}
+
 /// Leases the next job; 204 when the queue is empty.
 #[utoipa::path(post, path = "/api/v1/worker/claim", request_body = ClaimRequest,
     responses((status = 200, body = ClaimedJob), (status = 204, description = "no job queued"), (status = 401)),
@@ -66,13 +97,15 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
     request_body = HeartbeatRequest,
     responses((status = 200, body = HeartbeatResponse), (status = 401), (status = 404, body = ErrorBody),
         (status = 409, body = ErrorBody, description = "not the lease holder; nothing stored"),
-        (status = 410, body = ErrorBody, description = "campaign cancelled; drop the job"), (status = 422, body = ErrorBody)),
+        (status = 410, body = ErrorBody, description = "campaign cancelled; drop the job"),
+        (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
 async fn heartbeat(
     State(s): State<AppState>,
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<HeartbeatRequest>,
 ) -> Result<Json<HeartbeatResponse>> {
+    check_checkpoint(&s, job, req.checkpoint.as_ref()).await?;
     Ok(Json(
         s.store
             .heartbeat(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
@@ -83,13 +116,14 @@ async fn heartbeat(
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/complete", params(("job_id" = i64, Path)),
     request_body = CompleteRequest,
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody),
-        (status = 410, body = ErrorBody), (status = 422, body = ErrorBody)),
+        (status = 410, body = ErrorBody), (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
 async fn complete(
     State(s): State<AppState>,
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<CompleteRequest>,
 ) -> Result<StatusCode> {
+    check_checkpoint(&s, job, req.checkpoint.as_ref()).await?;
     s.store
         .complete(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
         .await?;
@@ -113,13 +147,15 @@ async fn fail(
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/release", params(("job_id" = i64, Path)),
     request_body = ReleaseRequest,
-    responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody)),
+    responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody),
+        (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
 async fn release(
     State(s): State<AppState>,
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<ReleaseRequest>,
 ) -> Result<StatusCode> {
+    check_checkpoint(&s, job, req.checkpoint.as_ref()).await?;
     s.store
         .release(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
         .await?;

@@ -1,0 +1,274 @@
+//! Checkpoint envelopes: the bytes of `grit_erosion::Sample::checkpoint` with the job they
+//! belong to, their length and their SHA-256, and the one check both ends run on them. The
+//! coordinator refuses an upload that fails it (nothing of that request is stored), and a
+//! worker that gets a stored checkpoint failing it starts the sample again from impact 0.
+
+use base64::Engine;
+use grit_erosion::{ImpactParams, Sample, SampleError};
+use sha2::{Digest, Sha256};
+
+use crate::api::Checkpoint;
+
+/// Lowercase hex SHA-256 of `bytes` (FIPS 180-4), the checksum an envelope carries.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    format!("{:x}", Sha256::digest(bytes))
+}
+
+impl Checkpoint {
+    /// The envelope of checkpoint `bytes` of job `job_id` after `impacts_done` impacts.
+    pub fn from_bytes(job_id: i64, impacts_done: u32, bytes: &[u8]) -> Checkpoint {
+        Checkpoint {
+            job_id,
+            impacts_done,
+            size_bytes: bytes.len() as u64,
+            sha256: sha256_hex(bytes),
+            data_b64: base64::engine::general_purpose::STANDARD.encode(bytes),
+        }
+    }
+
+    /// The envelope of `sample`'s state now, as job `job_id`.
+    pub fn of_sample(job_id: i64, sample: &Sample) -> Checkpoint {
+        Checkpoint::from_bytes(job_id, sample.impacts_done(), &sample.checkpoint())
+    }
+}
+
+/// Why a checkpoint envelope was refused: the field at fault and the rule it broke. Every
+/// rule starts with the word "checkpoint" or names it, so logs say what was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field}: {rule}")]
+pub struct CheckpointError {
+    /// Path of the offending field (`checkpoint.sha256`, …).
+    pub field: &'static str,
+    /// What is wrong with it.
+    pub rule: String,
+}
+
+fn refuse(field: &'static str, rule: impl Into<String>) -> CheckpointError {
+    CheckpointError {
+        field,
+        rule: rule.into(),
+    }
+}
+
+/// Checks `c` as job `job_id`'s checkpoint, whose scene is `params` and seed `seed`, and
+/// returns the sample it resumes. In order: the envelope names this job; `data_b64` is base64
+/// of exactly `size_bytes` bytes (fewer means the upload was cut short); their SHA-256 is
+/// `sha256` (a flipped byte); they decode as a checkpoint (bytes cut short with the envelope
+/// rebuilt around them) of this job's scene and seed (another job's bytes); and they hold
+/// `impacts_done` impacts.
+pub fn verify(
+    c: &Checkpoint,
+    job_id: i64,
+    params: &ImpactParams,
+    seed: u64,
+) -> Result<Sample, CheckpointError> {
+    if c.job_id != job_id {
+        return Err(refuse(
+            "checkpoint.job_id",
+            format!(
+                "the checkpoint belongs to job {}, not job {job_id}",
+                c.job_id
+            ),
+        ));
+    }
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(&c.data_b64)
+        .map_err(|e| {
+            refuse(
+                "checkpoint.data_b64",
+                format!("checkpoint data is not base64 (standard alphabet, padded): {e}"),
+            )
+        })?;
+    let got = bytes.len() as u64;
+    if got < c.size_bytes {
+        return Err(refuse(
+            "checkpoint.data_b64",
+            format!(
+                "checkpoint truncated: {got} of its {} bytes arrived",
+                c.size_bytes
+            ),
+        ));
+    }
+    if got > c.size_bytes {
+        return Err(refuse(
+            "checkpoint.size_bytes",
+            format!(
+                "checkpoint data has {got} bytes but size_bytes says {}",
+                c.size_bytes
+            ),
+        ));
+    }
+    let hex = c.sha256.to_ascii_lowercase();
+    if hex.len() != 64 || !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
+        return Err(refuse(
+            "checkpoint.sha256",
+            "must be the SHA-256 of the checkpoint bytes as 64 hexadecimal digits",
+        ));
+    }
+    let actual = sha256_hex(&bytes);
+    if actual != hex {
+        return Err(refuse(
+            "checkpoint.sha256",
+            format!("checkpoint checksum mismatch: the {got} bytes hash to {actual}, not {hex}"),
+        ));
+    }
+    let sample = Sample::resume(params, seed, &bytes).map_err(|e| {
+        let rule = match e {
+            // Its text starts with "checkpoint: " already.
+            SampleError::Checkpoint(_) => e.to_string(),
+            other => format!("checkpoint: {other}"),
+        };
+        refuse("checkpoint.data_b64", rule)
+    })?;
+    if sample.impacts_done() != c.impacts_done {
+        return Err(refuse(
+            "checkpoint.impacts_done",
+            format!(
+                "is {} but the checkpoint holds {} impacts",
+                c.impacts_done,
+                sample.impacts_done()
+            ),
+        ));
+    }
+    Ok(sample)
+}
+
+#[cfg(test)]
+mod tests {
+    //! Each corruption of an envelope is caught by the check meant for it, with a message
+    //! naming it; an intact envelope resumes the very sample it was taken of.
+
+    use super::*;
+
+    /// A scene coarse enough that a fresh surface is built in milliseconds.
+    fn coarse() -> ImpactParams {
+        ImpactParams {
+            spacing_m: 40e-6,
+            surface_width_dg: 2.0,
+            surface_depth_dg: 2.0,
+            distribution_range_dg: 0.0,
+            ..ImpactParams::default()
+        }
+    }
+
+    fn good() -> (ImpactParams, Checkpoint, Vec<u8>) {
+        let params = coarse();
+        let sample = Sample::new(params.clone(), 3).unwrap();
+        let bytes = sample.checkpoint();
+        (params, Checkpoint::of_sample(7, &sample), bytes)
+    }
+
+    fn refused(c: &Checkpoint, params: &ImpactParams, seed: u64) -> CheckpointError {
+        verify(c, 7, params, seed).expect_err("refused")
+    }
+
+    #[test]
+    fn intact_checkpoint_resumes_its_sample() {
+        let (params, c, bytes) = good();
+        assert_eq!(c.size_bytes, bytes.len() as u64);
+        assert_eq!(c.sha256.len(), 64);
+        let s = verify(&c, 7, &params, 3).unwrap();
+        assert_eq!(s.checkpoint(), bytes);
+        // Upper-case hex is the same checksum.
+        let upper = Checkpoint {
+            sha256: c.sha256.to_ascii_uppercase(),
+            ..c
+        };
+        assert!(verify(&upper, 7, &params, 3).is_ok());
+    }
+
+    #[test]
+    fn sha256_is_the_standard_digest() {
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+
+    #[test]
+    fn another_jobs_envelope_is_refused_naming_both_jobs() {
+        let (params, c, _) = good();
+        let e = verify(&c, 8, &params, 3).unwrap_err();
+        assert_eq!(e.field, "checkpoint.job_id");
+        assert_eq!(e.rule, "the checkpoint belongs to job 7, not job 8");
+    }
+
+    #[test]
+    fn another_jobs_bytes_are_refused() {
+        let (params, c, _) = good();
+        let e = refused(&c, &params, 4);
+        assert_eq!(e.field, "checkpoint.data_b64");
+        assert!(e.rule.contains("belongs to another job"), "{e}");
+    }
+
+    #[test]
+    fn bytes_cut_short_in_transit_are_truncated() {
+        let (params, c, bytes) = good();
+        let cut = Checkpoint {
+            data_b64: base64::engine::general_purpose::STANDARD.encode(&bytes[..100]),
+            ..c.clone()
+        };
+        let e = refused(&cut, &params, 3);
+        assert_eq!(e.field, "checkpoint.data_b64");
+        assert_eq!(
+            e.rule,
+            format!(
+                "checkpoint truncated: 100 of its {} bytes arrived",
+                bytes.len()
+            )
+        );
+        // Base64 text cut mid-quantum is not base64 at all.
+        let text = Checkpoint {
+            data_b64: c.data_b64[..c.data_b64.len() - 3].to_string(),
+            ..c
+        };
+        let e = refused(&text, &params, 3);
+        assert!(e.rule.contains("not base64"), "{e}");
+    }
+
+    #[test]
+    fn bytes_cut_short_with_a_matching_checksum_do_not_decode() {
+        let (params, _, bytes) = good();
+        let cut = Checkpoint::from_bytes(7, 0, &bytes[..bytes.len() / 2]);
+        let e = refused(&cut, &params, 3);
+        assert_eq!(e.field, "checkpoint.data_b64");
+        assert!(e.rule.starts_with("checkpoint: truncated"), "{e}");
+    }
+
+    #[test]
+    fn a_flipped_byte_is_a_checksum_mismatch() {
+        let (params, c, mut bytes) = good();
+        let mid = bytes.len() / 2;
+        bytes[mid] ^= 0x10;
+        let flipped = Checkpoint {
+            data_b64: base64::engine::general_purpose::STANDARD.encode(&bytes),
+            ..c
+        };
+        let e = refused(&flipped, &params, 3);
+        assert_eq!(e.field, "checkpoint.sha256");
+        assert!(e.rule.starts_with("checkpoint checksum mismatch"), "{e}");
+    }
+
+    #[test]
+    fn extra_bytes_wrong_sizes_and_malformed_checksums_are_refused() {
+        let (params, c, mut bytes) = good();
+        bytes.push(0);
+        let longer = Checkpoint {
+            data_b64: base64::engine::general_purpose::STANDARD.encode(&bytes),
+            ..c.clone()
+        };
+        assert_eq!(refused(&longer, &params, 3).field, "checkpoint.size_bytes");
+        let no_hex = Checkpoint {
+            sha256: "xyz".into(),
+            ..c.clone()
+        };
+        assert_eq!(refused(&no_hex, &params, 3).field, "checkpoint.sha256");
+        let count = Checkpoint {
+            impacts_done: 2,
+            ..c
+        };
+        let e = refused(&count, &params, 3);
+        assert_eq!(e.field, "checkpoint.impacts_done");
+        assert_eq!(e.rule, "is 2 but the checkpoint holds 0 impacts");
+    }
+}
