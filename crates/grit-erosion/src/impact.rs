@@ -880,7 +880,10 @@ mod tests {
         let mut n = Numerics::default();
         n.engine.shepard_interval = 0;
         let json = serde_json::to_string(&n).unwrap();
-        assert!(json.ends_with(r#""absorbing_layers":0.0,"shepard_interval":0}"#), "{json}");
+        assert!(
+            json.ends_with(r#""absorbing_layers":0.0,"shepard_interval":0}"#),
+            "{json}"
+        );
         assert_eq!(serde_json::from_str::<Numerics>(&json).unwrap(), n);
         let n: Numerics = serde_json::from_str(r#"{"shepard_interval": 80}"#).unwrap();
         assert_eq!(n.engine.shepard_interval, 80);

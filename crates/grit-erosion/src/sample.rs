@@ -223,7 +223,8 @@ impl Sample {
         let c: Checkpoint = postcard::from_bytes(bytes).map_err(|e| {
             SampleError::Checkpoint(match e {
                 postcard::Error::DeserializeUnexpectedEnd => {
-                    "truncated: the bytes end before the checkpoint does".into()
+                    "truncated: the bytes end before the checkpoint does, so it cannot decode"
+                        .into()
                 }
                 e => format!("cannot decode: {e}"),
             })

@@ -12,7 +12,7 @@ K = 166.7e9  # bulk modulus of AISI 304 in the engine (E / 3(1 - 2 nu)), Pa
 RHO0 = 7890.0
 WINDOWS = [(1, 10), (41, 50), (91, 100), (141, 150), (191, 200), (241, 250), (291, 300)]
 COLOURS = {"small": "#1f77b4", "wide": "#d62728", "sponge": "#2ca02c", "shallow": "#9467bd",
-           "wide-r1": "#ff7f0e"}
+           "wide-r1": "#ff7f0e", "small-nofilter": "#17becf", "wide-nofilter": "#8c564b"}
 
 
 def load(path):

@@ -43,7 +43,9 @@ pub enum Variant {
 /// steps at CFL 0.3: the step is proportional to the Courant number).
 pub fn filter_interval_in_time(cfl: f64) -> u32 {
     let seed = Numerics::default().engine;
-    (seed.shepard_interval as f64 * seed.cfl / cfl).round().max(1.0) as u32
+    (seed.shepard_interval as f64 * seed.cfl / cfl)
+        .round()
+        .max(1.0) as u32
 }
 
 impl Variant {
