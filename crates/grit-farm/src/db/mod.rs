@@ -1,8 +1,10 @@
-//! The coordinator's SQLite store. Every state change is one `BEGIN IMMEDIATE` transaction
-//! on the single writer connection; reads go through a separate read-only pool so status
-//! polling never queues behind writes (WAL lets readers run beside the writer). `Store` is
-//! the one handle; its queries sit by resource beside the HTTP routes: `campaigns`, `worker`
-//! (leases and what lease holders report) and `workers`.
+//! The coordinator's SQLite store. Every state change is made in a `BEGIN IMMEDIATE`
+//! transaction on the single writer connection; the workers' frequent writes (claims,
+//! heartbeats, completions) are grouped several to a transaction by one writer task (`group`),
+//! the rare ones (campaigns, the lease sweep) take a transaction each. Reads go through a
+//! separate read-only pool so status polling never queues behind writes (WAL lets readers run
+//! beside the writer). `Store` is the one handle; its queries sit by resource beside the HTTP
+//! routes: `campaigns`, `worker` (leases and what lease holders report) and `workers`.
 
 use std::path::Path;
 use std::str::FromStr;
@@ -19,6 +21,7 @@ use crate::error::{Error, Result};
 mod campaigns;
 mod checkpoints;
 mod extend;
+mod group;
 mod worker;
 mod workers;
 
@@ -40,6 +43,7 @@ pub fn now_ms() -> i64 {
 pub struct Store {
     write: SqlitePool,
     read: SqlitePool,
+    group: group::GroupWriter,
     /// Lease length.
     pub lease_ttl: Duration,
     /// Attempts (lost or failed leases) after which a job stays `failed`.
@@ -69,6 +73,7 @@ impl Store {
             .connect_with(opts.read_only(true))
             .await?;
         Ok(Store {
+            group: group::GroupWriter::start(write.clone(), lease_ttl),
             write,
             read,
             lease_ttl,
