@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::api::{CompleteRequest, HeartbeatRequest};
 use crate::client::{Client, ClientError};
-use crate::db::Store;
+use crate::db::{Store, Synchronous};
 use crate::server::{self, Config, Secret};
 
 /// Why the load test could not run.
@@ -69,11 +69,13 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[i]
 }
 
-/// Runs the load test for each client count, `seconds` each, on a fresh database in `dir`.
+/// Runs the load test for each client count, `seconds` each, on a fresh database in `dir`
+/// whose commits are made durable as `synchronous` says.
 pub async fn run(
     dir: &std::path::Path,
     clients: &[usize],
     seconds: f64,
+    synchronous: Synchronous,
 ) -> Result<Vec<LoadTestRow>, LoadTestError> {
     if clients.is_empty() || clients.contains(&0) {
         return Err(LoadTestError::Clients);
@@ -83,7 +85,7 @@ pub async fn run(
         source,
     })?;
     let db = dir.join(format!("bench-{}.db", uuid::Uuid::new_v4()));
-    let store = Store::open(&db, Duration::from_secs(60), 3).await?;
+    let store = Store::open_with(&db, Duration::from_secs(60), 3, synchronous).await?;
     let token = uuid::Uuid::new_v4().to_string();
     let config = Config {
         submit_token: Secret::new(Some(token.clone())),

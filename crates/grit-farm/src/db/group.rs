@@ -1,15 +1,17 @@
 //! Group commit of the lease holders' writes. Claims, heartbeats, completions, failures and
 //! releases are queued to one writer task, which applies every request waiting at that moment
-//! inside one `BEGIN IMMEDIATE` transaction and commits once: a thousand workers then cost a
-//! few commits per second each carrying many requests, instead of one commit per request.
+//! inside one `BEGIN IMMEDIATE` transaction and commits once: with many workers, one commit
+//! (and one flush to the disk) then carries many requests instead of one.
 //!
 //! Each request is decided inside the shared transaction by the same rules as alone (lease
-//! checks, 409s, impacts skipped when already stored), after the requests queued before it,
-//! and within its own `SAVEPOINT`: a request that is refused is rolled back alone and the
-//! others go on. No request is answered before the transaction holding it has committed.
-//! When the transaction itself fails (a commit refused for a full disk, a savepoint SQLite
-//! already unwound), nothing of it is stored and each of its requests is applied again alone,
-//! in a transaction of its own, so each gets its own answer.
+//! checks, 409s, impacts skipped when already stored), after the requests queued before it.
+//! A refused request must leave nothing behind while the others go on: a group is applied
+//! first without savepoints, and at the first refusal it is rolled back and applied again
+//! with each request inside its own `SAVEPOINT`, so the refused one alone is undone. No
+//! request is answered before the transaction holding it has committed. When the
+//! transaction itself fails (a commit refused for a full disk, a savepoint SQLite already
+//! unwound), nothing of it is stored and each of its requests is applied again alone, in a
+//! transaction of its own, so each gets its own answer.
 
 use std::time::Duration;
 
@@ -210,9 +212,11 @@ async fn apply(
     reap: bool,
 ) -> Result<Reply> {
     Ok(match op {
-        Op::Claim { worker } => {
-            Reply::Claimed(apply_claim(tx, lease_ttl, worker, reap).await?.map(Box::new))
-        }
+        Op::Claim { worker } => Reply::Claimed(
+            apply_claim(tx, lease_ttl, worker, reap)
+                .await?
+                .map(Box::new),
+        ),
         Op::Heartbeat {
             job_id,
             lease,
@@ -245,9 +249,7 @@ async fn apply(
             impacts,
             checkpoint,
         } => {
-            Reply::Released(
-                apply_release(tx, *job_id, *lease, impacts, checkpoint.as_ref()).await?,
-            )
+            Reply::Released(apply_release(tx, *job_id, *lease, impacts, checkpoint.as_ref()).await?)
         }
     })
 }
