@@ -5,29 +5,13 @@ use std::time::Duration;
 
 use axum::http::StatusCode;
 use grit_erosion::campaign::CampaignSpec;
-use grit_erosion::{ImpactOutcome, ImpactRecord};
+use grit_erosion::ImpactRecord;
 use uuid::Uuid;
 
 use super::Store;
 
 fn record(k: u32) -> ImpactRecord {
-    ImpactRecord {
-        impact: k,
-        grain_mass_kg: 1e-4,
-        mass_loss_kg: 1e-6,
-        orientation_rad: 0.0,
-        aim_x_m: 0.0,
-        outcome: ImpactOutcome {
-            mass_loss_kg: 1e-6,
-            removed_particles: 0,
-            detached_kg: 0.0,
-            detached_particles: 0,
-            sim_time_s: 0.0,
-            steps: 0,
-            rebound_ratio: 0.0,
-            settled: true,
-        },
-    }
+    crate::loadtest::placeholder_record(k, 1e-4, 1e-6)
 }
 
 #[tokio::test]
