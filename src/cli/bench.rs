@@ -42,6 +42,10 @@ enum BenchWhat {
         /// Print JSON rows instead of a Markdown table.
         #[arg(long)]
         json: bool,
+        /// The scratch database's commits: `full` (flushed to the disk, as `grit serve`
+        /// does by default) or `normal` (see `grit serve --synchronous`).
+        #[arg(long, default_value = "full")]
+        synchronous: grit_farm::Synchronous,
     },
     /// One impact of the reference scene (hexagon, 45°, 100 m/s, AISI 304, 8 µm) timed on 1
     /// thread and on N threads from the same surface: particle-steps per second and stages.
@@ -215,9 +219,10 @@ pub fn run(a: BenchArgs) -> anyhow::Result<ExitCode> {
             seconds,
             dir,
             json,
+            synchronous,
         } => {
             super::init_tracing("warn");
-            super::runtime()?.block_on(farm(&dir, &clients, seconds, json))
+            super::runtime()?.block_on(farm(&dir, &clients, seconds, json, synchronous))
         }
         BenchWhat::Impact {
             scene,
@@ -263,8 +268,9 @@ async fn farm(
     clients: &[usize],
     seconds: f64,
     json: bool,
+    synchronous: grit_farm::Synchronous,
 ) -> anyhow::Result<ExitCode> {
-    let rows = grit_farm::loadtest::run(dir, clients, seconds).await?;
+    let rows = grit_farm::loadtest::run(dir, clients, seconds, synchronous).await?;
     if json {
         say!("{}", serde_json::to_string_pretty(&rows)?);
     } else {

@@ -32,6 +32,11 @@ pub struct ServeArgs {
     /// Lost or failed leases after which a job stays failed.
     #[arg(long, env = "GRIT_MAX_ATTEMPTS", default_value_t = 3)]
     pub max_attempts: u32,
+    /// When a write is answered: `full` once flushed to the disk (survives a power loss), or
+    /// `normal` once handed to the operating system (survives a killed coordinator, but an OS
+    /// crash or power loss may undo the last answered writes; faster on a slow disk).
+    #[arg(long, env = "GRIT_SYNCHRONOUS", default_value = "full")]
+    pub synchronous: grit_farm::Synchronous,
     /// Token for submitting and reading campaigns.
     #[arg(long, env = "GRIT_SUBMIT_TOKEN", hide_env_values = true)]
     pub submit_token: Option<String>,
@@ -101,10 +106,11 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
     if missing {
         tracing::warn!("a token is not set: its endpoints accept anyone who can connect");
     }
-    let store = Store::open(
+    let store = Store::open_with(
         &a.db,
         Duration::from_secs_f64(a.lease_ttl_s),
         a.max_attempts,
+        a.synchronous,
     )
     .await
     .with_context(|| format!("--db {}", a.db.display()))?;

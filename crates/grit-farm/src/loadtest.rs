@@ -5,13 +5,13 @@
 
 use std::time::{Duration, Instant};
 
-use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::campaign::{CampaignSpec, MAX_JOBS};
 use grit_erosion::{ImpactOutcome, ImpactRecord};
 use serde::Serialize;
 
 use crate::api::{CompleteRequest, HeartbeatRequest};
 use crate::client::{Client, ClientError};
-use crate::db::Store;
+use crate::db::{Store, Synchronous};
 use crate::server::{self, Config, Secret};
 
 /// Why the load test could not run.
@@ -61,6 +61,9 @@ pub struct LoadTestRow {
     pub errors: u64,
 }
 
+/// Jobs queued per second measured: above any rate the coordinator reaches.
+const JOBS_PER_S: f64 = 20_000.0;
+
 fn percentile(sorted: &[f64], p: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
@@ -69,11 +72,13 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[i]
 }
 
-/// Runs the load test for each client count, `seconds` each, on a fresh database in `dir`.
+/// Runs the load test for each client count, `seconds` each, on a fresh database in `dir`
+/// whose commits are made durable as `synchronous` says.
 pub async fn run(
     dir: &std::path::Path,
     clients: &[usize],
     seconds: f64,
+    synchronous: Synchronous,
 ) -> Result<Vec<LoadTestRow>, LoadTestError> {
     if clients.is_empty() || clients.contains(&0) {
         return Err(LoadTestError::Clients);
@@ -83,7 +88,7 @@ pub async fn run(
         source,
     })?;
     let db = dir.join(format!("bench-{}.db", uuid::Uuid::new_v4()));
-    let store = Store::open(&db, Duration::from_secs(60), 3).await?;
+    let store = Store::open_with(&db, Duration::from_secs(60), 3, synchronous).await?;
     let token = uuid::Uuid::new_v4().to_string();
     let config = Config {
         submit_token: Secret::new(Some(token.clone())),
@@ -96,11 +101,13 @@ pub async fn run(
     let base = format!("http://{}", running.addr);
     let mut rows = Vec::new();
     for &n in clients {
-        // Enough jobs that the queue never runs dry during the measurement.
-        let spec = CampaignSpec::from_json(
-            r#"{"angles_deg": [90], "shapes": ["hexagon"], "impacts": 1, "samples": 20000,
-                "allow_short_samples": true, "spacing_m": 25e-6}"#,
-        )
+        // Enough jobs that the queue never runs dry during the measurement: a client that
+        // finds it empty stops, and the level would under-report.
+        let samples = ((seconds * JOBS_PER_S).ceil() as usize).clamp(20_000, MAX_JOBS);
+        let spec = CampaignSpec::from_json(&format!(
+            r#"{{"angles_deg": [90], "shapes": ["hexagon"], "impacts": 1, "samples": {samples},
+                "allow_short_samples": true, "spacing_m": 25e-6}}"#
+        ))
         .map_err(crate::Error::from)?;
         store.create_campaign(&spec, None).await?;
         let deadline = Instant::now() + Duration::from_secs_f64(seconds);
@@ -117,13 +124,21 @@ pub async fn run(
         let mut jobs = 0;
         let mut errors = 0;
         let mut lat = Vec::new();
+        let mut ran_dry = false;
         for t in tasks {
             let tally = t.await?;
+            ran_dry |= tally.ran_dry;
             jobs += tally.jobs;
             errors += tally.errors;
             lat.extend(tally.heartbeat_ms);
         }
         let secs = start.elapsed().as_secs_f64();
+        if ran_dry {
+            tracing::warn!(
+                clients = n,
+                "the queue ran dry before the time was up: this level's rate is a lower bound"
+            );
+        }
         lat.sort_by(f64::total_cmp);
         let row = LoadTestRow {
             clients: n,
@@ -154,6 +169,8 @@ struct Tally {
     jobs: u64,
     errors: u64,
     heartbeat_ms: Vec<f64>,
+    /// Found the queue empty and stopped early.
+    ran_dry: bool,
 }
 
 /// Claims, heartbeats and completes jobs until `deadline`. A failed request is counted and
@@ -164,7 +181,10 @@ async fn client_loop(client: Client, name: String, deadline: Instant) -> Tally {
     while Instant::now() < deadline {
         let job = match client.claim(&name).await {
             Ok(Some(job)) => job,
-            Ok(None) => break,
+            Ok(None) => {
+                t.ran_dry = true;
+                break;
+            }
             Err(e) => {
                 t.errors += 1;
                 tracing::debug!(error = %e, "load-test claim failed");

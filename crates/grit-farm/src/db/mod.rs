@@ -1,8 +1,10 @@
-//! The coordinator's SQLite store. Every state change is one `BEGIN IMMEDIATE` transaction
-//! on the single writer connection; reads go through a separate read-only pool so status
-//! polling never queues behind writes (WAL lets readers run beside the writer). `Store` is
-//! the one handle; its queries sit by resource beside the HTTP routes: `campaigns`, `worker`
-//! (leases and what lease holders report) and `workers`.
+//! The coordinator's SQLite store. Every state change is made in a `BEGIN IMMEDIATE`
+//! transaction on the single writer connection; the workers' frequent writes (claims,
+//! heartbeats, completions) are grouped several to a transaction by one writer task (`group`),
+//! the rare ones (campaigns, the lease sweep) take a transaction each. Reads go through a
+//! separate read-only pool so status polling never queues behind writes (WAL lets readers run
+//! beside the writer). `Store` is the one handle; its queries sit by resource beside the HTTP
+//! routes: `campaigns`, `worker` (leases and what lease holders report) and `workers`.
 
 use std::path::Path;
 use std::str::FromStr;
@@ -19,11 +21,14 @@ use crate::error::{Error, Result};
 mod campaigns;
 mod checkpoints;
 mod extend;
+mod group;
 mod worker;
 mod workers;
 
 #[cfg(test)]
 mod extend_tests;
+#[cfg(test)]
+mod group_tests;
 #[cfg(test)]
 mod tests;
 
@@ -40,22 +45,61 @@ pub fn now_ms() -> i64 {
 pub struct Store {
     write: SqlitePool,
     read: SqlitePool,
+    group: group::GroupWriter,
     /// Lease length.
     pub lease_ttl: Duration,
     /// Attempts (lost or failed leases) after which a job stays `failed`.
     pub max_attempts: u32,
 }
 
+/// When a commit counts as done, and so when a write is answered: SQLite's `synchronous`
+/// setting under WAL (`docs/operations.md`, "Durability of what was answered").
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Synchronous {
+    /// Every commit is flushed to the disk before it is answered: nothing answered is lost
+    /// to a killed process, an operating-system crash or a power loss.
+    #[default]
+    Full,
+    /// A commit is answered once handed to the operating system, and flushed at WAL
+    /// checkpoints: nothing answered is lost to a killed process, but an operating-system
+    /// crash or a power loss may undo the last commits.
+    Normal,
+}
+
+impl std::str::FromStr for Synchronous {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "full" => Ok(Synchronous::Full),
+            "normal" => Ok(Synchronous::Normal),
+            _ => Err(format!("expected full or normal, got {s:?}")),
+        }
+    }
+}
+
 impl Store {
-    /// Opens (creating if missing) the database at `path` and applies the migrations.
+    /// Opens (creating if missing) the database at `path` and applies the migrations, with
+    /// every commit flushed to the disk. Starts the group writer on the current runtime.
     pub async fn open(path: &Path, lease_ttl: Duration, max_attempts: u32) -> Result<Store> {
+        Store::open_with(path, lease_ttl, max_attempts, Synchronous::Full).await
+    }
+
+    /// [`Store::open`] with commits made durable as `synchronous` says.
+    pub async fn open_with(
+        path: &Path,
+        lease_ttl: Duration,
+        max_attempts: u32,
+        synchronous: Synchronous,
+    ) -> Result<Store> {
         let opts = SqliteConnectOptions::new()
             .filename(path)
             .create_if_missing(true)
             .journal_mode(SqliteJournalMode::Wal)
-            // NORMAL in WAL mode survives a crashed process (the tests kill the coordinator);
-            // only an OS crash can lose the last transactions.
-            .synchronous(SqliteSynchronous::Normal)
+            .synchronous(match synchronous {
+                Synchronous::Full => SqliteSynchronous::Full,
+                Synchronous::Normal => SqliteSynchronous::Normal,
+            })
             .busy_timeout(Duration::from_secs(30))
             .foreign_keys(true);
         let write = SqlitePoolOptions::new()
@@ -69,6 +113,7 @@ impl Store {
             .connect_with(opts.read_only(true))
             .await?;
         Ok(Store {
+            group: group::GroupWriter::start(write.clone(), lease_ttl),
             write,
             read,
             lease_ttl,

@@ -1,18 +1,22 @@
 //! The store's side of the worker endpoints: leasing jobs, and the lease holder's writes
 //! (heartbeat, complete, fail, release) with the impacts and checkpoints they carry; expired
-//! leases go back to the queue.
+//! leases go back to the queue. The writes go through the group writer (`group`), which
+//! applies each with the `apply_*` function here inside a transaction shared with others.
+
+use std::time::Duration;
 
 use base64::Engine;
 use grit_erosion::{ImpactParams, ImpactRecord};
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
+use super::group::{mismatch, Op, Reply};
 use super::{now_ms, parse_uuid, Store};
 use crate::api::{Checkpoint, ClaimedJob, HeartbeatResponse};
 use crate::error::{Error, Result};
 
 /// Longest failure message kept per job.
-const MAX_ERROR_CHARS: usize = 4000;
+pub(super) const MAX_ERROR_CHARS: usize = 4000;
 /// Workers silent for longer are forgotten, so the table of names cannot grow without end.
 const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 
@@ -24,9 +28,8 @@ struct StoredCheckpoint {
     sha256: Option<String>,
 }
 
-/// A lease holder's write so far, in its still open transaction.
+/// A lease holder's write so far.
 struct Report {
-    tx: Transaction<'static, Sqlite>,
     now: i64,
     held: Held,
     /// Impacts stored for the job, this write's included.
@@ -67,79 +70,16 @@ impl Store {
 
     /// Leases the next queued job to `worker`, or `None` when the queue is empty.
     pub async fn claim(&self, worker: &str) -> Result<Option<ClaimedJob>> {
-        let mut tx = self.begin().await?;
-        let now = now_ms();
-        reap(&mut tx, now).await?;
-        // Every claim counts as a sign of life, an empty queue's too: idle workers are listed.
-        sqlx::query(
-            "INSERT INTO workers (name, first_seen_ms, last_seen_ms) VALUES (?1, ?2, ?2)
-             ON CONFLICT (name) DO UPDATE SET last_seen_ms = excluded.last_seen_ms",
-        )
-        .bind(worker)
-        .bind(now)
-        .execute(&mut *tx)
-        .await?;
-        let lease = Uuid::new_v4();
-        let expires = now + self.lease_ttl.as_millis() as i64;
-        let Some(r) = sqlx::query(
-            "UPDATE jobs SET state = 'leased', lease_id = ?, worker = ?, lease_expires_ms = ?,
-                             updated_ms = ?
-             WHERE id = (SELECT id FROM jobs WHERE state = 'queued'
-                         ORDER BY campaign_seq, sample_index, cell_index LIMIT 1)
-             RETURNING id, campaign_id, cell_index, sample_index, seed, impacts_planned,
-                       impacts_done",
-        )
-        .bind(lease.to_string())
-        .bind(worker)
-        .bind(expires)
-        .bind(now)
-        .fetch_optional(&mut *tx)
-        .await?
-        else {
-            tx.commit().await?;
-            return Ok(None);
-        };
-        let job_id: i64 = r.get("id");
-        let campaign: String = r.get("campaign_id");
-        let cell: i64 = r.get("cell_index");
-        let cell_row = sqlx::query(
-            "SELECT params, impacts, impacts_max FROM cells WHERE campaign_id = ? AND cell_index = ?",
-        )
-        .bind(&campaign)
-        .bind(cell)
-        .fetch_one(&mut *tx)
-        .await?;
-        let params: String = cell_row.get(0);
-        let extendable = cell_row
-            .get::<Option<i64>, _>(2)
-            .is_some_and(|max| cell_row.get::<i64, _>(1) < max);
-        let params: ImpactParams = serde_json::from_str(&params)
-            .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
-        let ckpt = load_checkpoint(&mut tx, job_id).await?;
-        tx.commit().await?;
-        tracing::debug!(job = job_id, worker, "job leased");
-        Ok(Some(ClaimedJob {
-            job_id,
-            lease_id: lease,
-            lease_ttl_s: self.lease_ttl.as_secs_f64(),
-            campaign_id: parse_uuid(&campaign)?,
-            cell: cell as u32,
-            sample: r.get::<i64, _>("sample_index") as u32,
-            seed: r.get::<i64, _>("seed") as u64,
-            impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
-            impacts_done: r.get::<i64, _>("impacts_done") as u32,
-            params,
-            extendable,
-            checkpoint: ckpt.map(|c| {
-                let mut out = Checkpoint::from_bytes(job_id, c.impacts_done, &c.data);
-                // The stored checksum, not one of the bytes as read now, so the worker
-                // notices bytes damaged at rest.
-                if let Some(sha) = c.sha256 {
-                    out.sha256 = sha;
-                }
-                out
-            }),
-        }))
+        match self
+            .group
+            .apply(Op::Claim {
+                worker: worker.to_owned(),
+            })
+            .await?
+        {
+            Reply::Claimed(job) => Ok(job.map(|j| *j)),
+            _ => Err(mismatch()),
+        }
     }
 
     /// Renews the lease, stores finished impacts and an optional checkpoint.
@@ -150,24 +90,16 @@ impl Store {
         impacts: &[ImpactRecord],
         checkpoint: Option<&Checkpoint>,
     ) -> Result<HeartbeatResponse> {
-        let Report {
-            mut tx, now, done, ..
-        } = self.report(job_id, lease, impacts, checkpoint).await?;
-        let expires = now + self.lease_ttl.as_millis() as i64;
-        sqlx::query(
-            "UPDATE jobs SET lease_expires_ms = ?, impacts_done = ?, updated_ms = ? WHERE id = ?",
-        )
-        .bind(expires)
-        .bind(done as i64)
-        .bind(now)
-        .bind(job_id)
-        .execute(&mut *tx)
-        .await?;
-        tx.commit().await?;
-        Ok(HeartbeatResponse {
-            impacts_done: done,
-            lease_expires_ms: expires,
-        })
+        let op = Op::Heartbeat {
+            job_id,
+            lease,
+            impacts: impacts.to_vec(),
+            checkpoint: checkpoint.cloned(),
+        };
+        match self.group.apply(op).await? {
+            Reply::Beat(r) => Ok(r),
+            _ => Err(mismatch()),
+        }
     }
 
     /// Stores the last impacts and marks the job done; it must then have every planned impact.
@@ -180,33 +112,13 @@ impl Store {
         impacts: &[ImpactRecord],
         checkpoint: Option<&Checkpoint>,
     ) -> Result<()> {
-        let Report {
-            mut tx,
-            now,
-            held,
-            done,
-        } = self.report(job_id, lease, impacts, checkpoint).await?;
-        if done < held.planned {
-            return Err(Error::invalid(
-                "impacts",
-                format!(
-                    "the job has {done} of its {} planned impacts; send the rest before completing",
-                    held.planned
-                ),
-            ));
-        }
-        end_lease(&mut tx, job_id, "done", done, now).await?;
-        let (campaign, cell, plan) = super::extend::plan_of_job(&mut tx, job_id).await?;
-        if !plan.impacts_may_grow() {
-            sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
-                .bind(job_id)
-                .execute(&mut *tx)
-                .await?;
-        }
-        super::extend::settle_cell(&mut tx, &campaign, cell, plan, now).await?;
-        tx.commit().await?;
-        tracing::debug!(job = job_id, "job done");
-        Ok(())
+        let op = Op::Complete {
+            job_id,
+            lease,
+            impacts: impacts.to_vec(),
+            checkpoint: checkpoint.cloned(),
+        };
+        self.group.apply(op).await.map(drop)
     }
 
     /// Records a failure: back to the queue, or `failed` once attempts reach the maximum.
@@ -217,27 +129,13 @@ impl Store {
         error: &str,
         impacts: &[ImpactRecord],
     ) -> Result<()> {
-        let Report {
-            mut tx, now, done, ..
-        } = self.report(job_id, lease, impacts, None).await?;
-        let error: String = error.chars().take(MAX_ERROR_CHARS).collect();
-        sqlx::query(
-            "UPDATE jobs SET attempts = attempts + 1, impacts_done = ?, last_error = ?,
-                 state = CASE WHEN attempts + 1 >=
-                     (SELECT max_attempts FROM campaigns WHERE id = jobs.campaign_id)
-                     THEN 'failed' ELSE 'queued' END,
-                 lease_id = NULL, worker = NULL, lease_expires_ms = NULL, updated_ms = ?
-             WHERE id = ?",
-        )
-        .bind(done as i64)
-        .bind(&error)
-        .bind(now)
-        .bind(job_id)
-        .execute(&mut *tx)
-        .await?;
-        tx.commit().await?;
-        tracing::warn!(job = job_id, error = %error, "job attempt failed");
-        Ok(())
+        let op = Op::Fail {
+            job_id,
+            lease,
+            error: error.to_owned(),
+            impacts: impacts.to_vec(),
+        };
+        self.group.apply(op).await.map(drop)
     }
 
     /// Gives a job back without counting an attempt, keeping its impacts and checkpoint.
@@ -248,39 +146,209 @@ impl Store {
         impacts: &[ImpactRecord],
         checkpoint: Option<&Checkpoint>,
     ) -> Result<()> {
-        let Report {
-            mut tx, now, done, ..
-        } = self.report(job_id, lease, impacts, checkpoint).await?;
-        end_lease(&mut tx, job_id, "queued", done, now).await?;
-        tx.commit().await?;
-        tracing::info!(job = job_id, impacts = done, "job released");
-        Ok(())
+        let op = Op::Release {
+            job_id,
+            lease,
+            impacts: impacts.to_vec(),
+            checkpoint: checkpoint.cloned(),
+        };
+        self.group.apply(op).await.map(drop)
     }
+}
 
-    /// Opens the transaction of a lease holder's write: checks the lease, marks the worker
-    /// seen, and stores `impacts` and then the checkpoint, if any.
-    async fn report(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        impacts: &[ImpactRecord],
-        checkpoint: Option<&Checkpoint>,
-    ) -> Result<Report> {
-        let mut tx = self.begin().await?;
-        let now = now_ms();
-        let held = check_lease(&mut tx, job_id, lease, now).await?;
-        touch_worker(&mut tx, job_id, now).await?;
-        let done = store_impacts(&mut tx, job_id, &held, impacts, now).await?;
-        if let Some(c) = checkpoint {
-            store_checkpoint(&mut tx, job_id, done, c, now).await?;
-        }
-        Ok(Report {
-            tx,
-            now,
-            held,
-            done,
-        })
+/// Leases the next queued job to `worker` in `tx`, sweeping expired leases first when `sweep`
+/// is set (a group sweeps once for all its claims).
+pub(super) async fn apply_claim(
+    tx: &mut Transaction<'static, Sqlite>,
+    lease_ttl: Duration,
+    worker: &str,
+    sweep: bool,
+) -> Result<Option<ClaimedJob>> {
+    let now = now_ms();
+    if sweep {
+        reap(tx, now).await?;
     }
+    // Every claim counts as a sign of life, an empty queue's too: idle workers are listed.
+    sqlx::query(
+        "INSERT INTO workers (name, first_seen_ms, last_seen_ms) VALUES (?1, ?2, ?2)
+         ON CONFLICT (name) DO UPDATE SET last_seen_ms = excluded.last_seen_ms",
+    )
+    .bind(worker)
+    .bind(now)
+    .execute(&mut **tx)
+    .await?;
+    let lease = Uuid::new_v4();
+    let expires = now + lease_ttl.as_millis() as i64;
+    let Some(r) = sqlx::query(
+        "UPDATE jobs SET state = 'leased', lease_id = ?, worker = ?, lease_expires_ms = ?,
+                         updated_ms = ?
+         WHERE id = (SELECT id FROM jobs WHERE state = 'queued'
+                     ORDER BY campaign_seq, sample_index, cell_index LIMIT 1)
+         RETURNING id, campaign_id, cell_index, sample_index, seed, impacts_planned,
+                   impacts_done",
+    )
+    .bind(lease.to_string())
+    .bind(worker)
+    .bind(expires)
+    .bind(now)
+    .fetch_optional(&mut **tx)
+    .await?
+    else {
+        return Ok(None);
+    };
+    let job_id: i64 = r.get("id");
+    let campaign: String = r.get("campaign_id");
+    let cell: i64 = r.get("cell_index");
+    let cell_row = sqlx::query(
+        "SELECT params, impacts, impacts_max FROM cells WHERE campaign_id = ? AND cell_index = ?",
+    )
+    .bind(&campaign)
+    .bind(cell)
+    .fetch_one(&mut **tx)
+    .await?;
+    let params: String = cell_row.get(0);
+    let extendable = cell_row
+        .get::<Option<i64>, _>(2)
+        .is_some_and(|max| cell_row.get::<i64, _>(1) < max);
+    let params: ImpactParams = serde_json::from_str(&params)
+        .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
+    let ckpt = load_checkpoint(tx, job_id).await?;
+    Ok(Some(ClaimedJob {
+        job_id,
+        lease_id: lease,
+        lease_ttl_s: lease_ttl.as_secs_f64(),
+        campaign_id: parse_uuid(&campaign)?,
+        cell: cell as u32,
+        sample: r.get::<i64, _>("sample_index") as u32,
+        seed: r.get::<i64, _>("seed") as u64,
+        impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
+        impacts_done: r.get::<i64, _>("impacts_done") as u32,
+        params,
+        extendable,
+        checkpoint: ckpt.map(|c| {
+            let mut out = Checkpoint::from_bytes(job_id, c.impacts_done, &c.data);
+            // The stored checksum, not one of the bytes as read now, so the worker
+            // notices bytes damaged at rest.
+            if let Some(sha) = c.sha256 {
+                out.sha256 = sha;
+            }
+            out
+        }),
+    }))
+}
+
+/// A heartbeat in `tx`: renews the lease, stores finished impacts and an optional checkpoint.
+pub(super) async fn apply_heartbeat(
+    tx: &mut Transaction<'static, Sqlite>,
+    lease_ttl: Duration,
+    job_id: i64,
+    lease: Uuid,
+    impacts: &[ImpactRecord],
+    checkpoint: Option<&Checkpoint>,
+) -> Result<HeartbeatResponse> {
+    let Report { now, done, .. } = report(tx, job_id, lease, impacts, checkpoint).await?;
+    let expires = now + lease_ttl.as_millis() as i64;
+    sqlx::query(
+        "UPDATE jobs SET lease_expires_ms = ?, impacts_done = ?, updated_ms = ? WHERE id = ?",
+    )
+    .bind(expires)
+    .bind(done as i64)
+    .bind(now)
+    .bind(job_id)
+    .execute(&mut **tx)
+    .await?;
+    Ok(HeartbeatResponse {
+        impacts_done: done,
+        lease_expires_ms: expires,
+    })
+}
+
+/// A completion in `tx`, by the rules of [`Store::complete`].
+pub(super) async fn apply_complete(
+    tx: &mut Transaction<'static, Sqlite>,
+    job_id: i64,
+    lease: Uuid,
+    impacts: &[ImpactRecord],
+    checkpoint: Option<&Checkpoint>,
+) -> Result<()> {
+    let Report { now, held, done } = report(tx, job_id, lease, impacts, checkpoint).await?;
+    if done < held.planned {
+        return Err(Error::invalid(
+            "impacts",
+            format!(
+                "the job has {done} of its {} planned impacts; send the rest before completing",
+                held.planned
+            ),
+        ));
+    }
+    end_lease(tx, job_id, "done", done, now).await?;
+    let (campaign, cell, plan) = super::extend::plan_of_job(tx, job_id).await?;
+    if !plan.impacts_may_grow() {
+        sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
+            .bind(job_id)
+            .execute(&mut **tx)
+            .await?;
+    }
+    super::extend::settle_cell(tx, &campaign, cell, plan, now).await
+}
+
+/// A failure in `tx`, by the rules of [`Store::fail`].
+pub(super) async fn apply_fail(
+    tx: &mut Transaction<'static, Sqlite>,
+    job_id: i64,
+    lease: Uuid,
+    error: &str,
+    impacts: &[ImpactRecord],
+) -> Result<()> {
+    let Report { now, done, .. } = report(tx, job_id, lease, impacts, None).await?;
+    let error: String = error.chars().take(MAX_ERROR_CHARS).collect();
+    sqlx::query(
+        "UPDATE jobs SET attempts = attempts + 1, impacts_done = ?, last_error = ?,
+             state = CASE WHEN attempts + 1 >=
+                 (SELECT max_attempts FROM campaigns WHERE id = jobs.campaign_id)
+                 THEN 'failed' ELSE 'queued' END,
+             lease_id = NULL, worker = NULL, lease_expires_ms = NULL, updated_ms = ?
+         WHERE id = ?",
+    )
+    .bind(done as i64)
+    .bind(&error)
+    .bind(now)
+    .bind(job_id)
+    .execute(&mut **tx)
+    .await?;
+    Ok(())
+}
+
+/// A release in `tx`, by the rules of [`Store::release`]; returns the impacts the job keeps.
+pub(super) async fn apply_release(
+    tx: &mut Transaction<'static, Sqlite>,
+    job_id: i64,
+    lease: Uuid,
+    impacts: &[ImpactRecord],
+    checkpoint: Option<&Checkpoint>,
+) -> Result<u32> {
+    let Report { now, done, .. } = report(tx, job_id, lease, impacts, checkpoint).await?;
+    end_lease(tx, job_id, "queued", done, now).await?;
+    Ok(done)
+}
+
+/// The start of a lease holder's write in `tx`: checks the lease, marks the worker seen, and
+/// stores `impacts` and then the checkpoint, if any.
+async fn report(
+    tx: &mut Transaction<'static, Sqlite>,
+    job_id: i64,
+    lease: Uuid,
+    impacts: &[ImpactRecord],
+    checkpoint: Option<&Checkpoint>,
+) -> Result<Report> {
+    let now = now_ms();
+    let held = check_lease(tx, job_id, lease, now).await?;
+    touch_worker(tx, job_id, now).await?;
+    let done = store_impacts(tx, job_id, &held, impacts, now).await?;
+    if let Some(c) = checkpoint {
+        store_checkpoint(tx, job_id, done, c, now).await?;
+    }
+    Ok(Report { now, held, done })
 }
 
 /// What the lease check learns about the job.
@@ -474,7 +542,7 @@ async fn load_checkpoint(
     )
 }
 
-async fn reap(tx: &mut Transaction<'static, Sqlite>, now: i64) -> Result<u64> {
+pub(super) async fn reap(tx: &mut Transaction<'static, Sqlite>, now: i64) -> Result<u64> {
     let n = sqlx::query(
         "UPDATE jobs SET attempts = attempts + 1,
              last_error = 'lease expired (worker ' || COALESCE(worker, '?') || ' stopped reporting)',
