@@ -74,20 +74,15 @@ pub struct ContactPair {
     pub spring: Vec<Vector>,
     /// Penetration of the previous step per particle (0 while out of contact), for the dashpot.
     pub penetration: Vec<f64>,
-    /// Smallest mass of a secondary particle (kg/m), for the contact time step: each spring
-    /// pushes one secondary particle against the primary, whose particles move with its body.
+    /// Smallest mass of a particle the springs act on (kg/m), for the contact time step.
     pub min_mass: f64,
 }
 
 impl ContactPair {
-    /// The longest stable step of this pair's springs alone (s), for a secondary particle of
-    /// mass `min_mass` held by the primary (symplectic Euler: ω·dt ≤ 2(√(1+ζ²) − ζ)). The
-    /// normal spring k_r and the friction spring k_f act along orthogonal directions, so the
-    /// stiffer of the two sets ω; with ζ the dashpot's damping ratio (eqs. 24–25).
-    pub fn stable_dt(&self) -> f64 {
-        let omega = (self.k_r.max(self.k_f) / self.min_mass).sqrt();
-        let zeta = self.params.damping_ratio;
-        2.0 * ((1.0 + zeta * zeta).sqrt() - zeta) / omega
+    /// Whether a particle of body `body` with `flags` carries this pair's springs: any particle
+    /// of the secondary, boundary particles of the primary.
+    pub fn touches(&self, body: usize, flags: u8) -> bool {
+        body == self.secondary || (body == self.primary && flags & crate::particles::BOUNDARY != 0)
     }
 }
 

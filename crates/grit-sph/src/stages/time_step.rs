@@ -28,7 +28,7 @@ pub(crate) fn stable_dt(
     }
     for c in contacts.iter().filter(|_| settings.contact_limits_dt) {
         if c.min_mass.is_finite() {
-            dt = dt.min(settings.cfl * c.stable_dt());
+            dt = dt.min(settings.cfl * (c.min_mass / (c.k_r + c.k_f)).sqrt() * 2.0);
         }
     }
     dt

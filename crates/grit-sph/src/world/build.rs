@@ -42,7 +42,7 @@ impl World {
         for c in &mut self.contacts {
             c.spring.push(Vector::zeros());
             c.penetration.push(0.0);
-            if body == c.secondary {
+            if c.touches(body, flags) {
                 c.min_mass = c.min_mass.min(mass);
             }
         }
@@ -442,7 +442,7 @@ impl World {
         let p = &self.particles;
         for c in &mut self.contacts {
             c.min_mass = (0..p.len())
-                .filter(|&i| p.body[i] as usize == c.secondary)
+                .filter(|&i| c.touches(p.body[i] as usize, p.flags[i]))
                 .map(|i| p.mass[i])
                 .fold(f64::INFINITY, f64::min);
         }
