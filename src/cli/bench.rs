@@ -120,7 +120,8 @@ pub struct SweepArgs {
     #[arg(long, value_delimiter = ',', default_values_t = vec![8.0, 12.0, 16.0, 24.0, 32.0])]
     ppd: Vec<f64>,
     /// Numerical variants, comma-separated: seed (the numerics of Mohseni-Mofidi et al.
-    /// 2022), wendland_c2, full_flight, cfl=X, cfl_time=X (CFL X with the density filter's
+    /// 2022: CFL 0.3, the density filter every 40 steps), default (grit's default scene),
+    /// wendland_c2, full_flight, cfl=X, cfl_time=X (CFL X with the density filter's
     /// seed period in simulated time), filter=N (the density filter every N steps, 0 = off),
     /// absorbing=N; the first is the reference.
     #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]

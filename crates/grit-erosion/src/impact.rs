@@ -40,12 +40,13 @@ pub struct ImpactParams {
     /// The impact ends once the grain has left and the surface kinetic energy is below this
     /// fraction of the grain's initial kinetic energy.
     pub settle_fraction: f64,
-    /// Numerical choices; the defaults are the seed's (the speed–accuracy sweep varies them).
+    /// Numerical choices; the defaults are the seed's at CFL 0.6 with the density filter's
+    /// period kept in time (the speed–accuracy sweep varies them).
     pub numerics: Numerics,
 }
 
 /// The numerical choices of an impact scene that the speed–accuracy and stability studies
-/// vary; the defaults are the seed's sections 2–3, plus savings that change no result.
+/// vary; `Numerics::seed` holds the seed's sections 2–3, the default runs them at CFL 0.6.
 ///
 /// In JSON it keeps one flat object of the choices a scene may set (`NumericsJson`): the
 /// engine's `kernel`, `cfl`, `hourglass`, `contact_limits_dt`, `cell_order`, and `grain_shell`
@@ -72,8 +73,23 @@ pub struct Numerics {
     pub absorbing_layers: f64,
 }
 
-impl Default for Numerics {
-    fn default() -> Self {
+/// Courant number of the default scene: twice the seed's, with the density filter kept at the
+/// seed's period in simulated time (docs/erosion.md, "The density filter and the time step").
+pub const DEFAULT_CFL: f64 = 0.6;
+
+/// Steps between density filters (eq. 12) that keep the seed's period in simulated time, 40
+/// steps at CFL 0.3, at Courant number `cfl`: the step is proportional to the Courant number.
+pub fn filter_interval_in_time(cfl: f64) -> u32 {
+    let seed = Settings::default();
+    (seed.shepard_interval as f64 * seed.cfl / cfl)
+        .round()
+        .clamp(1.0, u32::MAX as f64) as u32
+}
+
+impl Numerics {
+    /// The seed's numerics (sections 2–3: quintic kernel, CFL 0.3, the filter every 40 steps),
+    /// plus the savings that change no result beyond rounding (`rigid_shell`, `skip_flight`).
+    pub fn seed() -> Self {
         Numerics {
             engine: Settings {
                 // Ours, not the seed's: bitwise the same results at less cost (tests/sample.rs).
@@ -85,6 +101,22 @@ impl Default for Numerics {
             skip_flight: true,
             absorbing_layers: 0.0,
         }
+    }
+
+    /// Sets the Courant number and the density filter's interval that keeps the seed's period
+    /// in simulated time (`filter_interval_in_time`).
+    pub fn with_cfl_filter_in_time(mut self, cfl: f64) -> Self {
+        self.engine.cfl = cfl;
+        self.engine.shepard_interval = filter_interval_in_time(cfl);
+        self
+    }
+}
+
+impl Default for Numerics {
+    /// The seed's numerics at CFL 0.6 with the filter's period kept in time: within the
+    /// sampling error of the seed's at 45° and 90° with 1.7× fewer steps (docs/erosion.md).
+    fn default() -> Self {
+        Numerics::seed().with_cfl_filter_in_time(DEFAULT_CFL)
     }
 }
 
@@ -102,14 +134,11 @@ struct NumericsJson {
     skip_flight: bool,
     cell_order: bool,
     absorbing_layers: f64,
-    // Written only where it differs from the seed's, so the scenes stored before this key
-    // existed keep their bytes.
-    #[serde(skip_serializing_if = "is_seed_interval")]
-    shepard_interval: u32,
-}
-
-fn is_seed_interval(n: &u32) -> bool {
-    *n == Settings::default().shepard_interval
+    // Absent, the filter keeps the seed's period in time at this scene's `cfl`; written only
+    // where it differs from that, so scenes at CFL 0.3 stored before this key existed keep
+    // their bytes and their meaning.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shepard_interval: Option<u32>,
 }
 
 impl Default for NumericsJson {
@@ -131,7 +160,8 @@ impl From<Numerics> for NumericsJson {
             skip_flight: n.skip_flight,
             cell_order: n.engine.cell_order,
             absorbing_layers: n.absorbing_layers,
-            shepard_interval: n.engine.shepard_interval,
+            shepard_interval: (n.engine.shepard_interval != filter_interval_in_time(n.engine.cfl))
+                .then_some(n.engine.shepard_interval),
         }
     }
 }
@@ -146,7 +176,9 @@ impl From<NumericsJson> for Numerics {
                 contact_limits_dt: j.contact_limits_dt,
                 rigid_shell: j.grain_shell,
                 cell_order: j.cell_order,
-                shepard_interval: j.shepard_interval,
+                shepard_interval: j
+                    .shepard_interval
+                    .unwrap_or_else(|| filter_interval_in_time(j.cfl)),
                 ..Settings::default()
             },
             contact_model: j.contact_model,
@@ -867,7 +899,7 @@ mod tests {
         let json = serde_json::to_string(&n).unwrap();
         assert_eq!(
             json,
-            r#"{"kernel":"quintic","cfl":0.3,"hourglass":0.1,"contact_model":"extrapolated","contact_stiffness_scale":1.0,"contact_limits_dt":true,"grain_shell":true,"skip_flight":true,"cell_order":false,"absorbing_layers":0.0}"#
+            r#"{"kernel":"quintic","cfl":0.6,"hourglass":0.1,"contact_model":"extrapolated","contact_stiffness_scale":1.0,"contact_limits_dt":true,"grain_shell":true,"skip_flight":true,"cell_order":false,"absorbing_layers":0.0}"#
         );
         assert_eq!(serde_json::from_str::<Numerics>(&json).unwrap(), n);
         let n: Numerics = serde_json::from_str(r#"{"cfl": 0.2, "grain_shell": false}"#).unwrap();
@@ -876,7 +908,24 @@ mod tests {
     }
 
     #[test]
-    fn the_density_filter_interval_is_written_only_where_it_is_not_the_seeds() {
+    fn the_density_filter_interval_is_written_only_where_it_is_not_the_seeds_period_in_time() {
+        assert_eq!(Numerics::seed().engine.shepard_interval, 40);
+        assert_eq!(Numerics::seed().engine.cfl, 0.3);
+        let n = Numerics::default();
+        assert_eq!((n.engine.cfl, n.engine.shepard_interval), (DEFAULT_CFL, 20));
+        assert_eq!(filter_interval_in_time(0.45), 27);
+        assert_eq!(filter_interval_in_time(100.0), 1);
+        // A scene that only sets `cfl` keeps the seed's period in time; one stored at CFL 0.3
+        // without the key reads as the seed's 40 steps.
+        let at = |json: &str| {
+            let n: Numerics = serde_json::from_str(json).unwrap();
+            (n.engine.cfl, n.engine.shepard_interval)
+        };
+        assert_eq!(at(r#"{"cfl": 0.3}"#), (0.3, 40));
+        assert_eq!(at(r#"{"cfl": 0.45}"#), (0.45, 27));
+        assert_eq!(at(r#"{}"#), (0.6, 20));
+        assert_eq!(at(r#"{"cfl": 0.6, "shepard_interval": 40}"#), (0.6, 40));
+        assert_eq!(at(r#"{"shepard_interval": 80}"#), (0.6, 80));
         let mut n = Numerics::default();
         n.engine.shepard_interval = 0;
         let json = serde_json::to_string(&n).unwrap();
@@ -885,8 +934,8 @@ mod tests {
             "{json}"
         );
         assert_eq!(serde_json::from_str::<Numerics>(&json).unwrap(), n);
-        let n: Numerics = serde_json::from_str(r#"{"shepard_interval": 80}"#).unwrap();
-        assert_eq!(n.engine.shepard_interval, 80);
+        let seed = serde_json::to_string(&Numerics::seed()).unwrap();
+        assert!(!seed.contains("shepard_interval"), "{seed}");
         assert!(serde_json::from_str::<Numerics>(r#"{"shepard_interval": -1}"#).is_err());
     }
 }

@@ -208,7 +208,7 @@ impl Default for StabilityGrid {
 impl StabilityGrid {
     /// The numerics of every point, panel by panel, in the order they are run.
     pub fn points(&self) -> Vec<(Panel, Numerics)> {
-        let base = Numerics::default();
+        let base = Numerics::seed();
         let mut v = Vec::new();
         for &hourglass in &self.hourglass {
             for &cfl in &self.cfl {

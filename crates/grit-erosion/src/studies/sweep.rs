@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use crate::aggregate::{aggregate_cell, CellInput, SampleInput, SLOPE_WINDOW};
-use crate::impact::{ImpactParams, Numerics, MIN_SURFACE_LAYERS};
+use crate::impact::{filter_interval_in_time, ImpactParams, Numerics, MIN_SURFACE_LAYERS};
 use crate::sample::{Sample, SampleError};
 
 /// A numerical variant of the sweep: the numerics of Mohseni-Mofidi et al. 2022 (`seed`), or one
@@ -19,8 +19,12 @@ use crate::sample::{Sample, SampleError};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Variant {
-    /// The paper's numerics (quintic kernel, eq. 4; Courant number 0.3).
+    /// The paper's numerics (quintic kernel, eq. 4; Courant number 0.3; the density filter
+    /// every 40 steps), `Numerics::seed`.
     Seed,
+    /// The default scene's numerics (`Numerics::default`): the seed's at CFL 0.6 with the
+    /// density filter's period kept in time.
+    Default,
     /// The Wendland C2 kernel (support 2h, about 21 neighbours against the quintic's 48).
     WendlandC2,
     /// The paper's numerics at another Courant number.
@@ -39,22 +43,14 @@ pub enum Variant {
     CflFilterInTime(f64),
 }
 
-/// The density-filter interval in steps that keeps the seed's period in simulated time (40
-/// steps at CFL 0.3: the step is proportional to the Courant number).
-pub fn filter_interval_in_time(cfl: f64) -> u32 {
-    let seed = Numerics::default().engine;
-    (seed.shepard_interval as f64 * seed.cfl / cfl)
-        .round()
-        .max(1.0) as u32
-}
-
 impl Variant {
-    /// Parses `seed`, `wendland_c2`, `full_flight`, `cfl=X`, `cfl_time=X`, `filter=N` or
+    /// Parses `seed`, `default`, `wendland_c2`, `full_flight`, `cfl=X`, `cfl_time=X`, `filter=N` or
     /// `absorbing=N`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
+            "default" => Ok(Variant::Default),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
             "full_flight" => Ok(Variant::FullFlight),
             other if other.starts_with("filter=") => {
@@ -87,7 +83,7 @@ impl Variant {
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, wendland_c2, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N)"
+                    "unknown variant `{other}` (known: seed, default, wendland_c2, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N)"
                 )),
             },
         }
@@ -97,6 +93,11 @@ impl Variant {
     pub fn name(&self) -> String {
         match self {
             Variant::Seed => "seed (quintic, CFL 0.3)".into(),
+            Variant::Default => format!(
+                "default (CFL {}, density filter every {} steps)",
+                crate::impact::DEFAULT_CFL,
+                filter_interval_in_time(crate::impact::DEFAULT_CFL)
+            ),
             Variant::WendlandC2 => "Wendland C2".into(),
             Variant::Cfl(c) => format!("CFL {c}"),
             Variant::FullFlight => "seed, flight simulated".into(),
@@ -112,18 +113,16 @@ impl Variant {
 
     /// The scene's numerics under this variant.
     pub fn numerics(&self) -> Numerics {
-        let mut n = Numerics::default();
+        let mut n = Numerics::seed();
         match *self {
             Variant::Seed => {}
+            Variant::Default => n = Numerics::default(),
             Variant::WendlandC2 => n.engine.kernel = KernelKind::WendlandC2,
             Variant::Cfl(cfl) => n.engine.cfl = cfl,
             Variant::FullFlight => n.skip_flight = false,
             Variant::Absorbing(layers) => n.absorbing_layers = layers,
             Variant::Filter(every) => n.engine.shepard_interval = every,
-            Variant::CflFilterInTime(cfl) => {
-                n.engine.cfl = cfl;
-                n.engine.shepard_interval = filter_interval_in_time(cfl);
-            }
+            Variant::CflFilterInTime(cfl) => n = n.with_cfl_filter_in_time(cfl),
         }
         n
     }
@@ -520,6 +519,9 @@ mod tests {
     #[test]
     fn variants_parse_and_reject_bad_names() {
         assert_eq!(Variant::parse("seed"), Ok(Variant::Seed));
+        assert_eq!(Variant::parse("default"), Ok(Variant::Default));
+        assert_eq!(Variant::Seed.numerics(), Numerics::seed());
+        assert_eq!(Variant::Default.numerics(), Numerics::default());
         assert_eq!(Variant::parse("wendland_c2"), Ok(Variant::WendlandC2));
         assert_eq!(Variant::parse("cfl=0.5"), Ok(Variant::Cfl(0.5)));
         assert!(Variant::parse("cfl=3")
