@@ -43,6 +43,10 @@ enum Command {
     /// model, normalised erosion, modified Oka, convergence.
     #[command(after_help = "Example: grit plot out/quick/results.json --out out/charts")]
     Plot(plot::Args),
+    /// Print a results file's erosion normalised at 45° beside Oka's g(α), and its shape ratios
+    /// beside the seed's modified Oka, with standard errors and the project's goals.
+    #[command(after_help = "Example: grit compare docs/erosion/reduced-results.json")]
+    Compare(plot::CompareArgs),
     /// Run the coordinator: REST API under /api/v1 on a SQLite database.
     #[command(
         after_help = "Example: GRIT_SUBMIT_TOKEN=s3cret GRIT_WORKER_TOKEN=w0rker grit serve --db grit.db --listen 0.0.0.0:8080"
@@ -92,6 +96,7 @@ fn main() -> ExitCode {
         Command::Sample(a) => sample::sample(a),
         Command::Study(a) => study::study(a),
         Command::Plot(a) => plot::run(a),
+        Command::Compare(a) => plot::compare(a),
         Command::Bench(a) => bench::run(a),
         Command::Serve(a) => farm("info", serve::serve(a)),
         Command::Work(a) => farm("info", serve::work(a)),

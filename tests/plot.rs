@@ -365,3 +365,22 @@ fn plot_rejects_bad_input_with_a_clear_error() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+#[test]
+fn compare_prints_the_reference_tables_and_refuses_a_bad_file() {
+    let reduced = data("reduced-2026-11-21-results.json");
+    let out = grit(&["compare", reduced.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    // Oka's g(90°)/g(45°) at Hv 1.8 with silica exponents is 0.73 (docs/references.md).
+    assert!(
+        stdout.contains("| hexagon | 90° | 1.10 ± 0.37 | 0.43 ± 0.15 | 0.73 |"),
+        "{stdout}"
+    );
+    let out = grit(&["compare", reduced.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["angles"].as_array().unwrap().len(), 6);
+    let out = grit(&["compare", "no-such-results.json"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-results.json"));
+}

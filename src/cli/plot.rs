@@ -24,6 +24,39 @@ pub struct Args {
     pub out: Option<PathBuf>,
 }
 
+/// Arguments of `grit compare`.
+#[derive(ClapArgs)]
+pub struct CompareArgs {
+    /// Results JSON files, merged as `grit plot` merges them (a cell an earlier file already
+    /// has is left out).
+    #[arg(required = true)]
+    pub results: Vec<PathBuf>,
+    /// Print the comparison as JSON instead of Markdown tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Prints the results beside Oka's g(α) and the seed's shape ratios (`grit_erosion::compare`).
+pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
+    let inputs = a
+        .results
+        .iter()
+        .map(|p| Ok((p.display().to_string(), grit_plot::load(p)?)))
+        .collect::<Result<Vec<_>, grit_plot::PlotError>>()?;
+    let (input, notes) = grit_plot::merge(inputs)?;
+    let c = grit_erosion::compare::compare(&input.results);
+    let mut o = std::io::stdout().lock();
+    if a.json {
+        let _ = writeln!(o, "{}", serde_json::to_string_pretty(&c)?);
+    } else {
+        let _ = write!(o, "{}", grit_erosion::compare::markdown(&c));
+        for n in notes {
+            let _ = writeln!(o, "note: {n}");
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Draws the charts and prints the table, the notes and the files written.
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let inputs = a

@@ -6,6 +6,7 @@
 
 pub mod aggregate;
 pub mod campaign;
+pub mod compare;
 pub mod fits;
 pub mod impact;
 pub mod sample;
@@ -21,7 +22,9 @@ pub use fits::{
     fit_modified_oka, fit_oka, FitError, ModifiedOkaModel, OkaModel, ShapeExponents,
     ShapeReference, AISI304_HV_GPA,
 };
-pub use impact::{ImpactError, ImpactOutcome, ImpactParams, Numerics};
+pub use impact::{
+    filter_interval_in_time, ImpactError, ImpactOutcome, ImpactParams, Numerics, DEFAULT_CFL,
+};
 pub use sample::{ImpactRecord, Sample, SampleError};
 pub use shapes::{Shape, ShapeError, ShapeInfo};
 pub use steady::{SlopeFit, SteadyState};

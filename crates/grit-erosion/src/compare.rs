@@ -1,0 +1,376 @@
+//! A campaign's erosion beside the published references (Mohseni-Mofidi et al. 2022, section 4):
+//! erosion normalised at 45° against Oka's g(α) with silica exponents (eq. 35; Oka et al. 2005),
+//! and erosion of each shape over the hexagon's at the same angle against the seed's
+//! shape-modified Oka h(e, An, α) (eqs. 37–38 with the exponents of Fig. 14).
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use crate::aggregate::{CampaignResults, CellResult};
+use crate::fits::{
+    oka_g, oka_silica_exponents, shape_modification, ShapeExponents, ShapeReference, AISI304_HV_GPA,
+};
+use crate::shapes::Shape;
+
+/// The project's goal for normalised erosion: within ±15 % of Oka's g(α)/g(45°).
+pub const ANGLE_TOLERANCE: f64 = 0.15;
+/// The project's goal for shape ratios: within ±25 % of the seed's modified Oka.
+pub const SHAPE_TOLERANCE: f64 = 0.25;
+/// The reference angle of the normalisation (seed Fig. 11b).
+pub const REFERENCE_ANGLE_DEG: f64 = 45.0;
+/// The reference shape of the shape ratios (seed eq. 38).
+pub const REFERENCE_SHAPE: &str = "hexagon";
+
+/// A simulated ratio of two cells with its standard error, beside a reference value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ratio {
+    /// Simulated ratio; `null` when either cell has no erosion or the denominator is 0.
+    pub value: Option<f64>,
+    /// Its standard error from both cells' (independent samples): r √((s_a/a)² + (s_b/b)²).
+    pub sem: Option<f64>,
+    /// The published reference ratio.
+    pub reference: f64,
+    /// value / reference − 1.
+    pub deviation: Option<f64>,
+    /// (value − reference) / sem: how far the reference lies outside the sampling error.
+    pub z: Option<f64>,
+    /// Whether |deviation| is within the goal's tolerance.
+    pub within_goal: Option<bool>,
+    /// Whether both cells passed the steady-state check (`null`: one was not checked).
+    pub steady: Option<bool>,
+}
+
+/// One row of the angle table: a cell normalised by its shape's 45° cell.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AngleRow {
+    /// Grain shape.
+    pub shape: String,
+    /// Impact angle (degrees).
+    pub angle_deg: f64,
+    /// Cell erosion (mass lost / grain mass) and its standard error.
+    pub erosion: Option<f64>,
+    /// Standard error of `erosion`.
+    pub erosion_sem: Option<f64>,
+    /// E(α)/E(45°) against Oka's g(α)/g(45°).
+    pub ratio: Ratio,
+}
+
+/// One row of the shape table: a shape over the hexagon at the same angle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShapeRow {
+    /// Impact angle (degrees).
+    pub angle_deg: f64,
+    /// Grain shape.
+    pub shape: String,
+    /// E(shape)/E(hexagon) against the seed's h(e, An, α).
+    pub ratio: Ratio,
+}
+
+/// Both tables and the angle of largest mean erosion per shape.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Comparison {
+    /// Hardness the Oka reference uses (GPa).
+    pub hv_gpa: f64,
+    /// Oka's silica exponents n1, n2 at that hardness.
+    pub oka_exponents: (f64, f64),
+    /// Every cell that has its shape's 45° cell.
+    pub angles: Vec<AngleRow>,
+    /// Every non-hexagon cell that has a hexagon cell at its angle.
+    pub shapes: Vec<ShapeRow>,
+    /// Per shape with three or more angles: the angle of its largest mean erosion.
+    pub max_angle_deg: Vec<(String, f64)>,
+}
+
+fn cell<'a>(r: &'a CampaignResults, shape: &str, angle: f64) -> Option<&'a CellResult> {
+    r.cells
+        .iter()
+        .find(|c| c.shape == shape && (c.angle_deg - angle).abs() < 1e-9 && c.swept.is_empty())
+}
+
+fn steady(c: &CellResult) -> Option<bool> {
+    c.steady_state.as_ref().map(|s| s.steady)
+}
+
+fn ratio(num: &CellResult, den: &CellResult, reference: f64, tolerance: f64) -> Ratio {
+    let value = match (num.erosion_mean, den.erosion_mean) {
+        (Some(a), Some(b)) if b != 0.0 => Some(a / b),
+        _ => None,
+    };
+    let rel = |m: Option<f64>, s: Option<f64>| match (m, s) {
+        (Some(m), Some(s)) if m != 0.0 => Some(s / m),
+        _ => None,
+    };
+    let same = std::ptr::eq(num, den);
+    let sem = match (
+        value,
+        rel(num.erosion_mean, num.erosion_sem),
+        rel(den.erosion_mean, den.erosion_sem),
+    ) {
+        (Some(_), _, _) if same => Some(0.0),
+        (Some(v), Some(a), Some(b)) => Some(v.abs() * a.hypot(b)),
+        _ => None,
+    };
+    let deviation = value.map(|v| v / reference - 1.0);
+    Ratio {
+        value,
+        sem,
+        reference,
+        deviation,
+        z: match (value, sem) {
+            (Some(v), Some(s)) if s > 0.0 => Some((v - reference) / s),
+            _ => None,
+        },
+        within_goal: deviation.map(|d| d.abs() <= tolerance),
+        steady: match (steady(num), steady(den)) {
+            (Some(a), Some(b)) => Some(a && b),
+            _ => None,
+        },
+    }
+}
+
+/// Compares a campaign's cells (those without other swept values) with Oka's g(α) at AISI
+/// 304's hardness and with the seed's shape-modified Oka.
+pub fn compare(r: &CampaignResults) -> Comparison {
+    let hv = AISI304_HV_GPA;
+    let (n1, n2) = oka_silica_exponents(hv);
+    let g45 = oka_g(REFERENCE_ANGLE_DEG, n1, n2, hv);
+    let plain = || r.cells.iter().filter(|c| c.swept.is_empty());
+    let angles = plain()
+        .filter_map(|c| {
+            let den = cell(r, &c.shape, REFERENCE_ANGLE_DEG)?;
+            let reference = oka_g(c.angle_deg, n1, n2, hv) / g45;
+            Some(AngleRow {
+                shape: c.shape.clone(),
+                angle_deg: c.angle_deg,
+                erosion: c.erosion_mean,
+                erosion_sem: c.erosion_sem,
+                ratio: ratio(c, den, reference, ANGLE_TOLERANCE),
+            })
+        })
+        .collect();
+    let shapes = plain()
+        .filter(|c| c.shape != REFERENCE_SHAPE)
+        .filter_map(|c| {
+            let den = cell(r, REFERENCE_SHAPE, c.angle_deg)?;
+            let (angularity, aspect) = Shape::from_name(&c.shape)?.factors().ok()?;
+            let reference = shape_modification(
+                c.angle_deg,
+                aspect,
+                angularity,
+                &ShapeReference::HEXAGON,
+                &ShapeExponents::SEED,
+            );
+            Some(ShapeRow {
+                angle_deg: c.angle_deg,
+                shape: c.shape.clone(),
+                ratio: ratio(c, den, reference, SHAPE_TOLERANCE),
+            })
+        })
+        .collect();
+    let mut names: Vec<&str> = plain().map(|c| c.shape.as_str()).collect();
+    names.dedup();
+    let max_angle_deg = names
+        .into_iter()
+        .filter_map(|s| {
+            let cells: Vec<_> = plain()
+                .filter(|c| c.shape == s && c.erosion_mean.is_some())
+                .collect();
+            let best = cells
+                .iter()
+                .max_by(|a, b| a.erosion_mean.partial_cmp(&b.erosion_mean).unwrap())?;
+            (cells.len() >= 3).then(|| (s.to_string(), best.angle_deg))
+        })
+        .collect();
+    Comparison {
+        hv_gpa: hv,
+        oka_exponents: (n1, n2),
+        angles,
+        shapes,
+        max_angle_deg,
+    }
+}
+
+fn num(v: Option<f64>, digits: usize) -> String {
+    v.map_or("–".into(), |v| format!("{v:.digits$}"))
+}
+
+fn yes_no(v: Option<bool>, yes: &str, no: &str) -> String {
+    v.map_or("not checked".into(), |b| (if b { yes } else { no }).into())
+}
+
+fn ratio_cells(r: &Ratio) -> String {
+    format!(
+        "{} ± {} | {:.2} | {} | {} | {} | {}",
+        num(r.value, 2),
+        num(r.sem, 2),
+        r.reference,
+        r.deviation
+            .map_or("–".into(), |d| format!("{:+.0} %", 100.0 * d)),
+        num(r.z, 1),
+        yes_no(r.within_goal, "yes", "**no**"),
+        yes_no(r.steady, "steady", "**unsteady**"),
+    )
+}
+
+/// The comparison as Markdown tables, for `docs/erosion.md` and the terminal.
+pub fn markdown(c: &Comparison) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Erosion normalised at 45° against Oka's g(α)/g(45°) (silica exponents n1 = {:.3}, n2 = {:.3} at Hv = {} GPa; goal ±{:.0} %):\n",
+        c.oka_exponents.0,
+        c.oka_exponents.1,
+        c.hv_gpa,
+        100.0 * ANGLE_TOLERANCE
+    );
+    let _ = writeln!(s, "| shape | angle | erosion (mg/g) ± s.e. | E/E(45°) ± s.e. | Oka | deviation | z | within goal | cells |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    for a in &c.angles {
+        let _ = writeln!(
+            s,
+            "| {} | {}° | {} ± {} | {} |",
+            a.shape,
+            a.angle_deg,
+            num(a.erosion.map(|e| 1e3 * e), 2),
+            num(a.erosion_sem.map(|e| 1e3 * e), 2),
+            ratio_cells(&a.ratio)
+        );
+    }
+    if !c.max_angle_deg.is_empty() {
+        s.push('\n');
+    }
+    for (shape, angle) in &c.max_angle_deg {
+        let _ = writeln!(
+            s,
+            "{shape}: largest mean erosion at {angle}° (goal: between 30° and 45°)."
+        );
+    }
+    if !c.shapes.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nErosion over the hexagon's at the same angle against the seed's modified Oka h(e, An, α) (eq. 38, Fig. 14 exponents; goal ±{:.0} %):\n",
+            100.0 * SHAPE_TOLERANCE
+        );
+        let _ = writeln!(
+            s,
+            "| angle | shape | E/E(hexagon) ± s.e. | seed | deviation | z | within goal | cells |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+        for r in &c.shapes {
+            let _ = writeln!(
+                s,
+                "| {}° | {} | {} |",
+                r.angle_deg,
+                r.shape,
+                ratio_cells(&r.ratio)
+            );
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::steady::SteadyState;
+
+    fn cell(shape: &str, angle: f64, mean: f64, sem: f64, steady: bool) -> CellResult {
+        let json = serde_json::json!({
+            "angle_deg": angle, "shape": shape, "partial": false, "samples": 10,
+            "samples_planned": 10, "samples_reported": 10, "samples_without_slope": 0,
+            "impacts_planned": 100, "erosion_mean": mean, "erosion_std": sem * 10f64.sqrt(),
+            "erosion_sem": sem, "per_sample": [], "mean_series": [], "convergence": [],
+        });
+        let mut c: CellResult = serde_json::from_value(json).unwrap();
+        c.steady_state = Some(SteadyState {
+            steady,
+            reason: String::new(),
+            incubation_impacts: None,
+            samples_without_loss: 0,
+            window_first_impact: None,
+            samples_incubated_by_window: 0,
+            slope_last10: None,
+            slope_prev10: None,
+        });
+        c
+    }
+
+    fn results(cells: Vec<CellResult>) -> CampaignResults {
+        CampaignResults {
+            partial: false,
+            slope_window: 20,
+            cells,
+            steady: None,
+            spec: None,
+            grit_version: None,
+        }
+    }
+
+    #[test]
+    fn the_seeds_shape_ratios_come_out_of_eq_38() {
+        // The values the seed's modified Oka gives (Mohseni-Mofidi et al. 2022, Fig. 14 exponents).
+        let mut cells = vec![cell("hexagon", 45.0, 1e-3, 1e-4, true)];
+        cells.push(cell("hexagon", 90.0, 1e-3, 1e-4, true));
+        for s in ["octagon", "square", "rectangle"] {
+            cells.push(cell(s, 45.0, 1e-3, 1e-4, true));
+            cells.push(cell(s, 90.0, 1e-3, 1e-4, false));
+        }
+        let c = compare(&results(cells));
+        let want = [
+            (45.0, "octagon", 0.87),
+            (90.0, "octagon", 0.75),
+            (45.0, "square", 1.39),
+            (90.0, "square", 2.00),
+            (45.0, "rectangle", 1.11),
+            (90.0, "rectangle", 1.49),
+        ];
+        assert_eq!(c.shapes.len(), 6);
+        for (angle, shape, seed) in want {
+            let row = c
+                .shapes
+                .iter()
+                .find(|r| r.angle_deg == angle && r.shape == shape)
+                .unwrap();
+            assert!(
+                (row.ratio.reference - seed).abs() < 0.006,
+                "{shape} at {angle}: {} against {seed}",
+                row.ratio.reference
+            );
+            assert_eq!(row.ratio.steady, Some(angle == 45.0));
+        }
+    }
+
+    #[test]
+    fn normalised_erosion_carries_both_cells_errors_and_oka_s_ratios() {
+        let c = compare(&results(vec![
+            cell("hexagon", 45.0, 2e-3, 2e-4, true),
+            cell("hexagon", 90.0, 1.5e-3, 3e-4, true),
+            cell("hexagon", 30.0, 3e-3, 0.0, true),
+        ]));
+        let row = |a: f64| c.angles.iter().find(|r| r.angle_deg == a).unwrap();
+        // Oka's g(90)/g(45) at Hv 1.8 with silica exponents is 1/1.374 (docs/references.md).
+        assert!((row(90.0).ratio.reference - 0.728).abs() < 0.002);
+        assert_eq!(row(90.0).ratio.value, Some(0.75));
+        let sem = 0.75 * (0.1f64.powi(2) + 0.2f64.powi(2)).sqrt();
+        assert!((row(90.0).ratio.sem.unwrap() - sem).abs() < 1e-12);
+        assert_eq!(row(90.0).ratio.within_goal, Some(true));
+        assert_eq!(
+            (row(45.0).ratio.value, row(45.0).ratio.sem),
+            (Some(1.0), Some(0.0))
+        );
+        assert_eq!(row(30.0).ratio.within_goal, Some(false));
+        assert_eq!(c.max_angle_deg, vec![("hexagon".to_string(), 30.0)]);
+        let md = markdown(&c);
+        assert!(
+            md.contains("| hexagon | 90° | 1.50 ± 0.30 | 0.75 ± 0.17 | 0.73 |"),
+            "{md}"
+        );
+    }
+
+    #[test]
+    fn a_cell_without_its_reference_is_left_out() {
+        let c = compare(&results(vec![cell("square", 90.0, 1e-3, 1e-4, true)]));
+        assert!(c.angles.is_empty() && c.shapes.is_empty());
+    }
+}
