@@ -32,6 +32,29 @@ impl Checkpoint {
     }
 }
 
+/// An uploaded checkpoint that passed [`verify_upload`]: its bytes and their SHA-256, decoded
+/// and hashed once where the request is received, so the store only writes them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CheckpointBytes {
+    /// Impacts the checkpoint contains.
+    pub impacts_done: u32,
+    /// `grit_erosion::Sample::checkpoint` bytes.
+    pub bytes: Vec<u8>,
+    /// Their SHA-256 (FIPS 180-4), lowercase hex.
+    pub sha256: String,
+}
+
+impl CheckpointBytes {
+    /// Checkpoint `bytes` after `impacts_done` impacts, hashed here (no other check).
+    pub fn new(impacts_done: u32, bytes: Vec<u8>) -> CheckpointBytes {
+        CheckpointBytes {
+            impacts_done,
+            sha256: sha256_hex(&bytes),
+            bytes,
+        }
+    }
+}
+
 /// Why a checkpoint envelope was refused: the field at fault and the rule it broke. Every
 /// rule starts with the word "checkpoint" or names it, so logs say what was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -62,6 +85,16 @@ pub fn verify(
     params: &ImpactParams,
     seed: u64,
 ) -> Result<Sample, CheckpointError> {
+    verify_upload(c, job_id, params, seed).map(|(sample, _)| sample)
+}
+
+/// [`verify`], also handing back the checked bytes and their SHA-256 for the store to keep.
+pub fn verify_upload(
+    c: &Checkpoint,
+    job_id: i64,
+    params: &ImpactParams,
+    seed: u64,
+) -> Result<(Sample, CheckpointBytes), CheckpointError> {
     if c.job_id != job_id {
         return Err(refuse(
             "checkpoint.job_id",
@@ -130,7 +163,12 @@ pub fn verify(
             ),
         ));
     }
-    Ok(sample)
+    let bytes = CheckpointBytes {
+        impacts_done: c.impacts_done,
+        bytes,
+        sha256: actual,
+    };
+    Ok((sample, bytes))
 }
 
 #[cfg(test)]
@@ -175,6 +213,10 @@ mod tests {
             ..c
         };
         assert!(verify(&upper, 7, &params, 3).is_ok());
+        // What the store keeps: the very bytes, and their checksum in lowercase.
+        let (_, kept) = verify_upload(&upper, 7, &params, 3).unwrap();
+        assert_eq!(kept, CheckpointBytes::new(0, bytes));
+        assert_eq!(kept.sha256, c.sha256);
     }
 
     #[test]

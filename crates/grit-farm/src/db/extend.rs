@@ -28,7 +28,8 @@ pub(super) struct CellPlan {
 }
 
 impl CellPlan {
-    fn from_row(r: &sqlx::sqlite::SqliteRow) -> CellPlan {
+    /// The plan in row `r`, whose columns carry the names of [`PLAN_COLUMNS`].
+    pub fn from_row(r: &sqlx::sqlite::SqliteRow) -> CellPlan {
         let impacts = r.get::<i64, _>("impacts") as u32;
         let samples = r.get::<i64, _>("samples") as u32;
         let until = match (
@@ -84,27 +85,6 @@ impl Store {
         .map(CellPlan::from_row)
         .collect())
     }
-}
-
-/// The plan of the cell of `job_id`, with its campaign and cell index.
-pub(super) async fn plan_of_job(
-    tx: &mut Transaction<'static, Sqlite>,
-    job_id: i64,
-) -> Result<(String, i64, CellPlan)> {
-    let r = sqlx::query(&format!(
-        "SELECT j.campaign_id, j.cell_index, {} FROM jobs j JOIN cells k
-           ON k.campaign_id = j.campaign_id AND k.cell_index = j.cell_index
-         WHERE j.id = ?",
-        PLAN_COLUMNS
-            .split(", ")
-            .map(|c| format!("k.{c} AS {c}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    ))
-    .bind(job_id)
-    .fetch_one(&mut **tx)
-    .await?;
-    Ok((r.get(0), r.get(1), CellPlan::from_row(&r)))
 }
 
 /// After a job of `cell` completed: once every job of the cell is done, grows the cell by

@@ -10,7 +10,8 @@ use sqlx::Row;
 use uuid::Uuid;
 
 use super::Store;
-use crate::api::{CampaignState, Checkpoint, ClaimedJob};
+use crate::api::{CampaignState, ClaimedJob};
+use crate::checkpoint::CheckpointBytes;
 use crate::loadtest::placeholder_record;
 
 async fn store(dir: &Path) -> Store {
@@ -33,8 +34,8 @@ fn record(k: u32, loss: f64) -> ImpactRecord {
 }
 
 /// A stand-in for the sample's state after its last impact.
-fn checkpoint(j: &ClaimedJob) -> Checkpoint {
-    Checkpoint::from_bytes(j.job_id, j.impacts_planned, &[0; 3])
+fn checkpoint(j: &ClaimedJob) -> CheckpointBytes {
+    CheckpointBytes::new(j.impacts_planned, vec![0; 3])
 }
 
 /// Claims the next job and completes it with impacts lost at `loss(sample, k)`, sending a
@@ -45,9 +46,7 @@ async fn run_one(s: &Store, loss: impl Fn(u32, u32) -> f64) -> ClaimedJob {
         .map(|k| record(k, loss(j.sample, k)))
         .collect();
     let ckpt = j.extendable.then(|| checkpoint(&j));
-    s.complete(j.job_id, j.lease_id, &recs, ckpt.as_ref())
-        .await
-        .unwrap();
+    s.complete(j.job_id, j.lease_id, &recs, ckpt).await.unwrap();
     j
 }
 
@@ -199,7 +198,7 @@ async fn a_repeated_complete_grows_nothing_twice() {
     let j = run_one(&s, |_, _| 0.0).await;
     // The worker did not hear the answer and sends the same complete again.
     let e = s
-        .complete(j.job_id, j.lease_id, &[], Some(&checkpoint(&j)))
+        .complete(j.job_id, j.lease_id, &[], Some(checkpoint(&j)))
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);

@@ -15,16 +15,17 @@
 
 use std::time::Duration;
 
-use grit_erosion::ImpactRecord;
 use sqlx::{Sqlite, SqlitePool, Transaction};
 use tokio::sync::{mpsc, oneshot};
 use uuid::Uuid;
 
 use super::now_ms;
 use super::worker::{
-    apply_claim, apply_complete, apply_fail, apply_heartbeat, apply_release, reap, MAX_ERROR_CHARS,
+    apply_claim, apply_complete, apply_fail, apply_heartbeat, apply_release, reap, Leased,
+    NewImpact,
 };
-use crate::api::{Checkpoint, ClaimedJob, HeartbeatResponse};
+use crate::api::HeartbeatResponse;
+use crate::checkpoint::CheckpointBytes;
 use crate::error::{Error, Result};
 
 /// Most requests applied in one transaction; more wait for the next one. Bounds how long
@@ -33,7 +34,9 @@ const MAX_GROUP: usize = 512;
 /// Requests that may wait for the writer before senders wait for room.
 const QUEUE: usize = 4096;
 
-/// A lease holder's write, owned so it can wait in the queue and be applied again alone.
+/// A lease holder's write, owned so it can wait in the queue and be applied again alone. It
+/// comes ready to store (records serialised, checkpoint decoded and hashed, error message
+/// cut to length), so the writer spends its time on the database alone.
 pub(super) enum Op {
     Claim {
         worker: String,
@@ -41,32 +44,32 @@ pub(super) enum Op {
     Heartbeat {
         job_id: i64,
         lease: Uuid,
-        impacts: Vec<ImpactRecord>,
-        checkpoint: Option<Checkpoint>,
+        impacts: Vec<NewImpact>,
+        checkpoint: Option<CheckpointBytes>,
     },
     Complete {
         job_id: i64,
         lease: Uuid,
-        impacts: Vec<ImpactRecord>,
-        checkpoint: Option<Checkpoint>,
+        impacts: Vec<NewImpact>,
+        checkpoint: Option<CheckpointBytes>,
     },
     Fail {
         job_id: i64,
         lease: Uuid,
         error: String,
-        impacts: Vec<ImpactRecord>,
+        impacts: Vec<NewImpact>,
     },
     Release {
         job_id: i64,
         lease: Uuid,
-        impacts: Vec<ImpactRecord>,
-        checkpoint: Option<Checkpoint>,
+        impacts: Vec<NewImpact>,
+        checkpoint: Option<CheckpointBytes>,
     },
 }
 
 /// What an applied request answers.
 pub(super) enum Reply {
-    Claimed(Option<Box<ClaimedJob>>),
+    Claimed(Option<Box<Leased>>),
     Beat(HeartbeatResponse),
     /// A release, with the impacts the job keeps.
     Released(u32),
@@ -262,7 +265,6 @@ fn log_applied(op: &Op, reply: &Reply) {
         }
         (Op::Complete { job_id, .. }, _) => tracing::debug!(job = job_id, "job done"),
         (Op::Fail { job_id, error, .. }, _) => {
-            let error: String = error.chars().take(MAX_ERROR_CHARS).collect();
             tracing::warn!(job = job_id, error = %error, "job attempt failed");
         }
         (Op::Release { job_id, .. }, Reply::Released(done)) => {

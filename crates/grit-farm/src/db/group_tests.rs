@@ -32,7 +32,7 @@ async fn a_refused_request_in_a_group_leaves_nothing_and_fails_no_other() {
     // The test runtime has one thread: all four are queued before the writer runs, so they
     // are applied in one group, in this order.
     let (gap, stale, good, claimed) = tokio::join!(
-        // Impact 1 is stored before the gap is found; the refusal must undo it.
+        // Impact 1 comes before the gap: nothing of the refused heartbeat may stay.
         s.heartbeat(a.job_id, a.lease_id, &with_gap, None),
         s.heartbeat(b.job_id, Uuid::new_v4(), &one, None),
         s.complete(b.job_id, b.lease_id, &both, None),

@@ -188,3 +188,68 @@ async fn a_full_database_is_503_and_recovers() {
     s.create_campaign(&big, None).await.unwrap();
     assert_eq!(s.list_campaigns().await.unwrap().len(), 1);
 }
+
+/// A report of more impacts than one insert statement takes stores every record bit for bit;
+/// a checkpoint stored by a heartbeat is handed back whole to the next lease holder, and
+/// dropped when a job of a fixed plan completes.
+#[tokio::test]
+async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_dropped() {
+    use crate::api::Checkpoint;
+    use crate::checkpoint::CheckpointBytes;
+    use crate::loadtest::placeholder_record;
+
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let spec = CampaignSpec::from_json(
+        &TINY
+            .replace(r#""samples": 2"#, r#""samples": 1"#)
+            .replace(r#""impacts": 2"#, r#""impacts": 400"#),
+    )
+    .unwrap();
+    s.create_campaign(&spec, None).await.unwrap();
+    let records: Vec<_> = (1..=400)
+        .map(|k| placeholder_record(k, 1e-4 / 3.0, 1e-7 * f64::from(k).sqrt()))
+        .collect();
+    let j = s.claim("w").await.unwrap().unwrap();
+    let bytes: Vec<u8> = (0..=255).cycle().take(1000).collect();
+    let beat = s
+        .heartbeat(
+            j.job_id,
+            j.lease_id,
+            &records[..350],
+            Some(CheckpointBytes::new(350, bytes.clone())),
+        )
+        .await
+        .unwrap();
+    assert_eq!(beat.impacts_done, 350);
+    s.release(j.job_id, j.lease_id, &[], None).await.unwrap();
+    let again = s.claim("w").await.unwrap().unwrap();
+    assert_eq!(again.impacts_done, 350);
+    assert_eq!(
+        serde_json::to_value(&again.checkpoint).unwrap(),
+        serde_json::to_value(Some(Checkpoint::from_bytes(j.job_id, 350, &bytes))).unwrap()
+    );
+    // Impacts already stored are skipped.
+    s.complete(again.job_id, again.lease_id, &records[300..], None)
+        .await
+        .unwrap();
+    let stored: Vec<(String, f64)> =
+        sqlx::query_as("SELECT record, mass_loss_kg FROM impacts WHERE job_id = ? ORDER BY impact")
+            .bind(j.job_id)
+            .fetch_all(&s.read)
+            .await
+            .unwrap();
+    assert_eq!(stored.len(), 400);
+    for (rec, (json, loss)) in records.iter().zip(&stored) {
+        assert_eq!(
+            serde_json::from_str::<grit_erosion::ImpactRecord>(json).unwrap(),
+            *rec
+        );
+        assert_eq!(loss.to_bits(), rec.mass_loss_kg.to_bits());
+    }
+    let kept: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM checkpoints")
+        .fetch_one(&s.read)
+        .await
+        .unwrap();
+    assert_eq!(kept, 0, "a done job of a fixed plan keeps no checkpoint");
+}

@@ -2,6 +2,10 @@
 //! (heartbeat, complete, fail, release) with the impacts and checkpoints they carry; expired
 //! leases go back to the queue. The writes go through the group writer (`group`), which
 //! applies each with the `apply_*` function here inside a transaction shared with others.
+//! That writer is the farm's bottleneck, so what needs no database is done by the caller
+//! before or after it: impact records are serialised and checkpoints decoded and hashed
+//! before a request is queued, and a lease's scene is parsed and its checkpoint encoded
+//! after the claim has committed.
 
 use std::time::Duration;
 
@@ -10,9 +14,11 @@ use grit_erosion::{ImpactParams, ImpactRecord};
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
+use super::extend::CellPlan;
 use super::group::{mismatch, Op, Reply};
 use super::{now_ms, parse_uuid, Store};
 use crate::api::{Checkpoint, ClaimedJob, HeartbeatResponse};
+use crate::checkpoint::{sha256_hex, CheckpointBytes};
 use crate::error::{Error, Result};
 
 /// Longest failure message kept per job.
@@ -20,12 +26,97 @@ pub(super) const MAX_ERROR_CHARS: usize = 4000;
 /// Workers silent for longer are forgotten, so the table of names cannot grow without end.
 const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 
+/// Impact rows inserted by one statement: 6 bound values each keeps it under SQLite's
+/// smallest limit on bound variables (999).
+const IMPACT_ROWS_PER_INSERT: usize = 150;
+
 /// A checkpoint as stored.
 struct StoredCheckpoint {
     impacts_done: u32,
     data: Vec<u8>,
     /// `None` for a checkpoint stored before checksums were.
     sha256: Option<String>,
+}
+
+impl StoredCheckpoint {
+    /// The envelope handed to the worker resuming job `job_id`. It carries the stored
+    /// checksum, not one of the bytes as read now, so the worker notices bytes damaged at
+    /// rest; a checkpoint stored before checksums were is hashed here.
+    fn envelope(self, job_id: i64) -> Checkpoint {
+        Checkpoint {
+            job_id,
+            impacts_done: self.impacts_done,
+            size_bytes: self.data.len() as u64,
+            sha256: self.sha256.unwrap_or_else(|| sha256_hex(&self.data)),
+            data_b64: base64::engine::general_purpose::STANDARD.encode(&self.data),
+        }
+    }
+}
+
+/// A lease as the writer granted it, with the scene still as stored; [`Leased::claimed`]
+/// makes it the claim's answer once the writer has moved on.
+pub(super) struct Leased {
+    pub job_id: i64,
+    lease: Uuid,
+    lease_ttl_s: f64,
+    campaign: String,
+    cell: i64,
+    sample: i64,
+    seed: i64,
+    planned: i64,
+    done: i64,
+    /// `cells.params`: the scene as JSON.
+    params: String,
+    extendable: bool,
+    checkpoint: Option<StoredCheckpoint>,
+}
+
+impl Leased {
+    /// The claim's answer: the scene parsed and the checkpoint enveloped.
+    fn claimed(self) -> Result<ClaimedJob> {
+        let job_id = self.job_id;
+        let params: ImpactParams = serde_json::from_str(&self.params)
+            .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
+        Ok(ClaimedJob {
+            job_id,
+            lease_id: self.lease,
+            lease_ttl_s: self.lease_ttl_s,
+            campaign_id: parse_uuid(&self.campaign)?,
+            cell: self.cell as u32,
+            sample: self.sample as u32,
+            seed: self.seed as u64,
+            impacts_planned: self.planned as u32,
+            impacts_done: self.done as u32,
+            params,
+            extendable: self.extendable,
+            checkpoint: self.checkpoint.map(|c| c.envelope(job_id)),
+        })
+    }
+}
+
+/// An impact record to store, serialised before it is queued so the writer only binds it.
+pub(super) struct NewImpact {
+    impact: u32,
+    grain_mass_kg: f64,
+    mass_loss_kg: f64,
+    /// The whole record as JSON, with round-trip float formatting (every f64 comes back
+    /// bit for bit).
+    json: String,
+}
+
+/// `impacts` ready to store.
+fn serialised(impacts: &[ImpactRecord]) -> Result<Vec<NewImpact>> {
+    impacts
+        .iter()
+        .map(|rec| {
+            Ok(NewImpact {
+                impact: rec.impact,
+                grain_mass_kg: rec.grain_mass_kg,
+                mass_loss_kg: rec.mass_loss_kg,
+                json: serde_json::to_string(rec).map_err(|e| Error::Internal(e.to_string()))?,
+            })
+        })
+        .collect()
 }
 
 /// A lease holder's write so far.
@@ -77,24 +168,25 @@ impl Store {
             })
             .await?
         {
-            Reply::Claimed(job) => Ok(job.map(|j| *j)),
+            Reply::Claimed(job) => job.map(|j| j.claimed()).transpose(),
             _ => Err(mismatch()),
         }
     }
 
-    /// Renews the lease, stores finished impacts and an optional checkpoint.
+    /// Renews the lease, stores finished impacts and an optional checkpoint (checked by the
+    /// caller: `crate::checkpoint::verify_upload`).
     pub async fn heartbeat(
         &self,
         job_id: i64,
         lease: Uuid,
         impacts: &[ImpactRecord],
-        checkpoint: Option<&Checkpoint>,
+        checkpoint: Option<CheckpointBytes>,
     ) -> Result<HeartbeatResponse> {
         let op = Op::Heartbeat {
             job_id,
             lease,
-            impacts: impacts.to_vec(),
-            checkpoint: checkpoint.cloned(),
+            impacts: serialised(impacts)?,
+            checkpoint,
         };
         match self.group.apply(op).await? {
             Reply::Beat(r) => Ok(r),
@@ -110,13 +202,13 @@ impl Store {
         job_id: i64,
         lease: Uuid,
         impacts: &[ImpactRecord],
-        checkpoint: Option<&Checkpoint>,
+        checkpoint: Option<CheckpointBytes>,
     ) -> Result<()> {
         let op = Op::Complete {
             job_id,
             lease,
-            impacts: impacts.to_vec(),
-            checkpoint: checkpoint.cloned(),
+            impacts: serialised(impacts)?,
+            checkpoint,
         };
         self.group.apply(op).await.map(drop)
     }
@@ -132,8 +224,8 @@ impl Store {
         let op = Op::Fail {
             job_id,
             lease,
-            error: error.to_owned(),
-            impacts: impacts.to_vec(),
+            error: error.chars().take(MAX_ERROR_CHARS).collect(),
+            impacts: serialised(impacts)?,
         };
         self.group.apply(op).await.map(drop)
     }
@@ -144,13 +236,13 @@ impl Store {
         job_id: i64,
         lease: Uuid,
         impacts: &[ImpactRecord],
-        checkpoint: Option<&Checkpoint>,
+        checkpoint: Option<CheckpointBytes>,
     ) -> Result<()> {
         let op = Op::Release {
             job_id,
             lease,
-            impacts: impacts.to_vec(),
-            checkpoint: checkpoint.cloned(),
+            impacts: serialised(impacts)?,
+            checkpoint,
         };
         self.group.apply(op).await.map(drop)
     }
@@ -163,7 +255,7 @@ pub(super) async fn apply_claim(
     lease_ttl: Duration,
     worker: &str,
     sweep: bool,
-) -> Result<Option<ClaimedJob>> {
+) -> Result<Option<Leased>> {
     let now = now_ms();
     if sweep {
         reap(tx, now).await?;
@@ -199,41 +291,40 @@ pub(super) async fn apply_claim(
     let job_id: i64 = r.get("id");
     let campaign: String = r.get("campaign_id");
     let cell: i64 = r.get("cell_index");
-    let cell_row = sqlx::query(
-        "SELECT params, impacts, impacts_max FROM cells WHERE campaign_id = ? AND cell_index = ?",
+    // The job's cell and its checkpoint, if any, in one statement.
+    let c = sqlx::query(
+        "SELECT c.params, c.impacts, c.impacts_max, k.impacts_done, k.data, k.sha256
+         FROM cells c LEFT JOIN checkpoints k ON k.job_id = ?1
+         WHERE c.campaign_id = ?2 AND c.cell_index = ?3",
     )
+    .bind(job_id)
     .bind(&campaign)
     .bind(cell)
     .fetch_one(&mut **tx)
     .await?;
-    let params: String = cell_row.get(0);
-    let extendable = cell_row
+    let extendable = c
         .get::<Option<i64>, _>(2)
-        .is_some_and(|max| cell_row.get::<i64, _>(1) < max);
-    let params: ImpactParams = serde_json::from_str(&params)
-        .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
-    let ckpt = load_checkpoint(tx, job_id).await?;
-    Ok(Some(ClaimedJob {
+        .is_some_and(|max| c.get::<i64, _>(1) < max);
+    let checkpoint = c
+        .get::<Option<i64>, _>(3)
+        .map(|impacts_done| StoredCheckpoint {
+            impacts_done: impacts_done as u32,
+            data: c.get(4),
+            sha256: c.get(5),
+        });
+    Ok(Some(Leased {
         job_id,
-        lease_id: lease,
+        lease,
         lease_ttl_s: lease_ttl.as_secs_f64(),
-        campaign_id: parse_uuid(&campaign)?,
-        cell: cell as u32,
-        sample: r.get::<i64, _>("sample_index") as u32,
-        seed: r.get::<i64, _>("seed") as u64,
-        impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
-        impacts_done: r.get::<i64, _>("impacts_done") as u32,
-        params,
+        campaign,
+        cell,
+        sample: r.get("sample_index"),
+        seed: r.get("seed"),
+        planned: r.get("impacts_planned"),
+        done: r.get("impacts_done"),
+        params: c.get(0),
         extendable,
-        checkpoint: ckpt.map(|c| {
-            let mut out = Checkpoint::from_bytes(job_id, c.impacts_done, &c.data);
-            // The stored checksum, not one of the bytes as read now, so the worker
-            // notices bytes damaged at rest.
-            if let Some(sha) = c.sha256 {
-                out.sha256 = sha;
-            }
-            out
-        }),
+        checkpoint,
     }))
 }
 
@@ -243,8 +334,8 @@ pub(super) async fn apply_heartbeat(
     lease_ttl: Duration,
     job_id: i64,
     lease: Uuid,
-    impacts: &[ImpactRecord],
-    checkpoint: Option<&Checkpoint>,
+    impacts: &[NewImpact],
+    checkpoint: Option<&CheckpointBytes>,
 ) -> Result<HeartbeatResponse> {
     let Report { now, done, .. } = report(tx, job_id, lease, impacts, checkpoint).await?;
     let expires = now + lease_ttl.as_millis() as i64;
@@ -268,8 +359,8 @@ pub(super) async fn apply_complete(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
-    impacts: &[ImpactRecord],
-    checkpoint: Option<&Checkpoint>,
+    impacts: &[NewImpact],
+    checkpoint: Option<&CheckpointBytes>,
 ) -> Result<()> {
     let Report { now, held, done } = report(tx, job_id, lease, impacts, checkpoint).await?;
     if done < held.planned {
@@ -282,26 +373,26 @@ pub(super) async fn apply_complete(
         ));
     }
     end_lease(tx, job_id, "done", done, now).await?;
-    let (campaign, cell, plan) = super::extend::plan_of_job(tx, job_id).await?;
-    if !plan.impacts_may_grow() {
+    // A job that never stored a checkpoint has none to drop.
+    if !held.plan.impacts_may_grow() && (held.has_checkpoint || checkpoint.is_some()) {
         sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
             .bind(job_id)
             .execute(&mut **tx)
             .await?;
     }
-    super::extend::settle_cell(tx, &campaign, cell, plan, now).await
+    super::extend::settle_cell(tx, &held.campaign, held.cell, held.plan, now).await
 }
 
-/// A failure in `tx`, by the rules of [`Store::fail`].
+/// A failure in `tx`, by the rules of [`Store::fail`]; `error` comes cut to
+/// [`MAX_ERROR_CHARS`].
 pub(super) async fn apply_fail(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
     error: &str,
-    impacts: &[ImpactRecord],
+    impacts: &[NewImpact],
 ) -> Result<()> {
     let Report { now, done, .. } = report(tx, job_id, lease, impacts, None).await?;
-    let error: String = error.chars().take(MAX_ERROR_CHARS).collect();
     sqlx::query(
         "UPDATE jobs SET attempts = attempts + 1, impacts_done = ?, last_error = ?,
              state = CASE WHEN attempts + 1 >=
@@ -311,7 +402,7 @@ pub(super) async fn apply_fail(
          WHERE id = ?",
     )
     .bind(done as i64)
-    .bind(&error)
+    .bind(error)
     .bind(now)
     .bind(job_id)
     .execute(&mut **tx)
@@ -324,8 +415,8 @@ pub(super) async fn apply_release(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
-    impacts: &[ImpactRecord],
-    checkpoint: Option<&Checkpoint>,
+    impacts: &[NewImpact],
+    checkpoint: Option<&CheckpointBytes>,
 ) -> Result<u32> {
     let Report { now, done, .. } = report(tx, job_id, lease, impacts, checkpoint).await?;
     end_lease(tx, job_id, "queued", done, now).await?;
@@ -338,12 +429,12 @@ async fn report(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
-    impacts: &[ImpactRecord],
-    checkpoint: Option<&Checkpoint>,
+    impacts: &[NewImpact],
+    checkpoint: Option<&CheckpointBytes>,
 ) -> Result<Report> {
     let now = now_ms();
     let held = check_lease(tx, job_id, lease, now).await?;
-    touch_worker(tx, job_id, now).await?;
+    touch_worker(tx, held.worker.as_deref(), now).await?;
     let done = store_impacts(tx, job_id, &held, impacts, now).await?;
     if let Some(c) = checkpoint {
         store_checkpoint(tx, job_id, done, c, now).await?;
@@ -351,10 +442,18 @@ async fn report(
     Ok(Report { now, held, done })
 }
 
-/// What the lease check learns about the job.
+/// What the lease check learns about the job, its cell's plan included (which a completion
+/// needs), so no write of a lease holder reads the job twice.
 struct Held {
     planned: u32,
     done: u32,
+    /// The lease holder's name.
+    worker: Option<String>,
+    campaign: String,
+    cell: i64,
+    plan: CellPlan,
+    /// Whether a checkpoint of the job is stored.
+    has_checkpoint: bool,
 }
 
 async fn check_lease(
@@ -364,16 +463,24 @@ async fn check_lease(
     now: i64,
 ) -> Result<Held> {
     let r = sqlx::query(
-        "SELECT state, lease_id, lease_expires_ms, impacts_planned, impacts_done
-         FROM jobs WHERE id = ?",
+        "SELECT j.state AS state, j.lease_id AS lease_id, j.lease_expires_ms AS lease_expires_ms,
+                j.impacts_planned AS impacts_planned, j.impacts_done AS impacts_done,
+                j.worker AS worker, j.campaign_id AS campaign_id, j.cell_index AS cell_index,
+                k.impacts AS impacts, k.samples AS samples, k.impacts_max AS impacts_max,
+                k.impacts_step AS impacts_step, k.samples_max AS samples_max,
+                k.target_sem_rel AS target_sem_rel,
+                EXISTS (SELECT 1 FROM checkpoints c WHERE c.job_id = j.id) AS has_checkpoint
+         FROM jobs j JOIN cells k ON k.campaign_id = j.campaign_id AND k.cell_index = j.cell_index
+         WHERE j.id = ?",
     )
     .bind(job_id)
     .fetch_optional(&mut **tx)
     .await?
     .ok_or_else(|| Error::NotFound(format!("job {job_id}")))?;
-    let state: String = r.get("state");
-    let holder: Option<String> = r.get("lease_id");
-    let mine = holder.as_deref() == Some(lease.to_string().as_str());
+    let state: &str = r.get("state");
+    let holder: Option<&str> = r.get("lease_id");
+    let mut text = Uuid::encode_buffer();
+    let mine = holder == Some(&*lease.hyphenated().encode_lower(&mut text));
     if mine && state == "cancelled" {
         return Err(Error::Gone(format!(
             "job {job_id} was cancelled with its campaign; drop it"
@@ -390,6 +497,11 @@ async fn check_lease(
     Ok(Held {
         planned: r.get::<i64, _>("impacts_planned") as u32,
         done: r.get::<i64, _>("impacts_done") as u32,
+        worker: r.get("worker"),
+        campaign: r.get("campaign_id"),
+        cell: r.get("cell_index"),
+        plan: CellPlan::from_row(&r),
+        has_checkpoint: r.get("has_checkpoint"),
     })
 }
 
@@ -416,74 +528,82 @@ async fn end_lease(
     Ok(())
 }
 
-/// Marks the worker holding `job_id` as seen at `now`; called by every write of a lease
-/// holder before anything clears `jobs.worker`.
-async fn touch_worker(tx: &mut Transaction<'static, Sqlite>, job_id: i64, now: i64) -> Result<()> {
-    sqlx::query(
-        "UPDATE workers SET last_seen_ms = ?
-         WHERE name = (SELECT worker FROM jobs WHERE id = ?)",
-    )
-    .bind(now)
-    .bind(job_id)
-    .execute(&mut **tx)
-    .await?;
+/// Marks the lease holder `worker` as seen at `now`; called by every write of a lease holder
+/// before anything clears `jobs.worker`.
+async fn touch_worker(
+    tx: &mut Transaction<'static, Sqlite>,
+    worker: Option<&str>,
+    now: i64,
+) -> Result<()> {
+    let Some(worker) = worker else {
+        return Ok(());
+    };
+    sqlx::query("UPDATE workers SET last_seen_ms = ? WHERE name = ?")
+        .bind(now)
+        .bind(worker)
+        .execute(&mut **tx)
+        .await?;
     Ok(())
 }
 
 /// Appends impacts after those stored; ones already stored are skipped (a resumed job
-/// re-runs impacts past its checkpoint, and a retried heartbeat resends). Returns the count
-/// stored afterwards.
+/// re-runs impacts past its checkpoint, and a retried heartbeat resends). Every record is
+/// checked before any is written, and the new ones go in with one statement. Returns the
+/// count stored afterwards.
 async fn store_impacts(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     held: &Held,
-    impacts: &[ImpactRecord],
+    impacts: &[NewImpact],
     now: i64,
 ) -> Result<u32> {
     let mut done = held.done;
+    let mut new = Vec::with_capacity(impacts.len());
     for (i, rec) in impacts.iter().enumerate() {
-        let field = format!("impacts[{i}]");
+        let field = |name: &str| format!("impacts[{i}].{name}");
         if rec.impact <= done {
             continue;
         }
         if rec.impact != done + 1 {
             return Err(Error::invalid(
-                format!("{field}.impact"),
+                field("impact"),
                 format!("expected impact {} next, got {}", done + 1, rec.impact),
             ));
         }
         if rec.impact > held.planned {
             return Err(Error::invalid(
-                format!("{field}.impact"),
+                field("impact"),
                 format!("the job plans only {} impacts", held.planned),
             ));
         }
         if !(rec.grain_mass_kg.is_finite() && rec.grain_mass_kg > 0.0) {
             return Err(Error::invalid(
-                format!("{field}.grain_mass_kg"),
+                field("grain_mass_kg"),
                 "must be finite and > 0",
             ));
         }
         if !(rec.mass_loss_kg.is_finite() && rec.mass_loss_kg >= 0.0) {
             return Err(Error::invalid(
-                format!("{field}.mass_loss_kg"),
+                field("mass_loss_kg"),
                 "must be finite and ≥ 0",
             ));
         }
-        let json = serde_json::to_string(rec).map_err(|e| Error::Internal(e.to_string()))?;
-        sqlx::query(
-            "INSERT INTO impacts (job_id, impact, grain_mass_kg, mass_loss_kg, record, created_ms)
-             VALUES (?, ?, ?, ?, ?, ?)",
-        )
-        .bind(job_id)
-        .bind(rec.impact as i64)
-        .bind(rec.grain_mass_kg)
-        .bind(rec.mass_loss_kg)
-        .bind(json)
-        .bind(now)
-        .execute(&mut **tx)
-        .await?;
+        new.push(rec);
         done = rec.impact;
+    }
+    for chunk in new.chunks(IMPACT_ROWS_PER_INSERT) {
+        let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
+            "INSERT INTO impacts (job_id, impact, grain_mass_kg, mass_loss_kg, record, created_ms) ",
+        );
+        qb.push_values(chunk, |mut b, rec| {
+            b.push_bind(job_id)
+                .push_bind(rec.impact as i64)
+                .push_bind(rec.grain_mass_kg)
+                .push_bind(rec.mass_loss_kg)
+                .push_bind(rec.json.as_str())
+                .push_bind(now);
+        });
+        qb.build().execute(&mut **tx).await?;
     }
     Ok(done)
 }
@@ -492,7 +612,7 @@ async fn store_checkpoint(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     stored: u32,
-    c: &Checkpoint,
+    c: &CheckpointBytes,
     now: i64,
 ) -> Result<()> {
     if c.impacts_done > stored {
@@ -504,10 +624,6 @@ async fn store_checkpoint(
             ),
         ));
     }
-    let data = base64::engine::general_purpose::STANDARD
-        .decode(&c.data_b64)
-        .map_err(|e| Error::invalid("checkpoint.data_b64", format!("not base64: {e}")))?;
-    let sha256 = crate::checkpoint::sha256_hex(&data);
     sqlx::query(
         "INSERT INTO checkpoints (job_id, impacts_done, data, sha256, updated_ms)
          VALUES (?, ?, ?, ?, ?)
@@ -517,29 +633,12 @@ async fn store_checkpoint(
     )
     .bind(job_id)
     .bind(c.impacts_done as i64)
-    .bind(data)
-    .bind(sha256)
+    .bind(c.bytes.as_slice())
+    .bind(c.sha256.as_str())
     .bind(now)
     .execute(&mut **tx)
     .await?;
     Ok(())
-}
-
-async fn load_checkpoint(
-    tx: &mut Transaction<'static, Sqlite>,
-    job_id: i64,
-) -> Result<Option<StoredCheckpoint>> {
-    Ok(
-        sqlx::query("SELECT impacts_done, data, sha256 FROM checkpoints WHERE job_id = ?")
-            .bind(job_id)
-            .fetch_optional(&mut **tx)
-            .await?
-            .map(|r| StoredCheckpoint {
-                impacts_done: r.get::<i64, _>(0) as u32,
-                data: r.get(1),
-                sha256: r.get(2),
-            }),
-    )
 }
 
 pub(super) async fn reap(tx: &mut Transaction<'static, Sqlite>, now: i64) -> Result<u64> {

@@ -1,7 +1,8 @@
 //! The endpoints workers call, under the worker token: claim a lease, then heartbeat (with
 //! impacts and checkpoints), complete, fail or release the job it holds. A checkpoint is
-//! verified (`crate::checkpoint::verify`) before the store sees the request, so a refused one
-//! leaves nothing of its request stored, impacts included.
+//! verified (`crate::checkpoint::verify_upload`) before the store sees the request, so a
+//! refused one leaves nothing of its request stored, impacts included; the store gets the
+//! bytes and checksum that check produced, and decodes nothing again.
 
 use axum::extract::{FromRequest, Path, Request, State};
 use axum::http::StatusCode;
@@ -11,7 +12,7 @@ use axum::{Json, Router};
 
 use super::AppState;
 use crate::api::*;
-use crate::checkpoint::verify;
+use crate::checkpoint::{verify_upload, CheckpointBytes};
 use crate::error::{Error, Result};
 
 /// The worker routes, relative to `/api/v1`.
@@ -56,24 +57,25 @@ where
     }
 }
 
-/// Refuses `checkpoint` with a 422 naming the field at fault unless it is intact and job
-/// `job_id`'s own (`crate::checkpoint::verify`); 404 for an unknown job.
+/// The bytes and checksum of `checkpoint` for the store, refused with a 422 naming the field
+/// at fault unless it is intact and job `job_id`'s own (`crate::checkpoint::verify_upload`);
+/// 404 for an unknown job.
 async fn check_checkpoint(
     s: &AppState,
     job_id: i64,
-    checkpoint: Option<&Checkpoint>,
-) -> Result<()> {
+    checkpoint: Option<Checkpoint>,
+) -> Result<Option<CheckpointBytes>> {
     let Some(c) = checkpoint else {
-        return Ok(());
+        return Ok(None);
     };
     let (params, seed) = s.store.job_scene(job_id).await?;
-    let c = c.clone();
     // Decoding a checkpoint of a large surface takes milliseconds: off the async threads.
-    let checked =
-        tokio::task::spawn_blocking(move || verify(&c, job_id, &params, seed).map(|_| ()))
-            .await
-            .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
-    checked.map_err(|e| {
+    let checked = tokio::task::spawn_blocking(move || {
+        verify_upload(&c, job_id, &params, seed).map(|(_, bytes)| bytes)
+    })
+    .await
+    .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
+    checked.map(Some).map_err(|e| {
         tracing::warn!(job = job_id, error = %e, "checkpoint refused; nothing of the request stored");
         Error::invalid(e.field, e.rule)
     })
@@ -105,10 +107,10 @@ async fn heartbeat(
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<HeartbeatRequest>,
 ) -> Result<Json<HeartbeatResponse>> {
-    check_checkpoint(&s, job, req.checkpoint.as_ref()).await?;
+    let checkpoint = check_checkpoint(&s, job, req.checkpoint).await?;
     Ok(Json(
         s.store
-            .heartbeat(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
+            .heartbeat(job, req.lease_id, &req.impacts, checkpoint)
             .await?,
     ))
 }
@@ -123,9 +125,9 @@ async fn complete(
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<CompleteRequest>,
 ) -> Result<StatusCode> {
-    check_checkpoint(&s, job, req.checkpoint.as_ref()).await?;
+    let checkpoint = check_checkpoint(&s, job, req.checkpoint).await?;
     s.store
-        .complete(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
+        .complete(job, req.lease_id, &req.impacts, checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
@@ -155,9 +157,9 @@ async fn release(
     Path(job): Path<i64>,
     ApiJson(req): ApiJson<ReleaseRequest>,
 ) -> Result<StatusCode> {
-    check_checkpoint(&s, job, req.checkpoint.as_ref()).await?;
+    let checkpoint = check_checkpoint(&s, job, req.checkpoint).await?;
     s.store
-        .release(job, req.lease_id, &req.impacts, req.checkpoint.as_ref())
+        .release(job, req.lease_id, &req.impacts, checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
