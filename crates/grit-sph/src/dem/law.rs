@@ -1,6 +1,6 @@
 //! Contact force laws of the DEM abrasives: the soft-sphere spring–dashpot with a Coulomb cap
-//! (Cundall & Strack 1979) and the abrasive–SPH-particle penalty contact of the water-jet paper
-//! (Sci. Rep. 14:26115, 2024; docs/jet.md#dem-abrasives).
+//! (Cundall & Strack 1979; the water-jet paper's eqs. 2–3, 10–11) and the abrasive–SPH-particle
+//! penalty contact (its eqs. 12–14); the paper is Sci. Rep. 14:26115 (2024), docs/jet.md#dem-abrasives.
 
 use crate::math::{perp, Vector};
 
@@ -100,14 +100,25 @@ impl SpringDashpot {
     }
 }
 
-/// Penalty contact between an SPH target particle and an abrasive (the paper's section on
-/// abrasive–target contact): the force on the particle, the abrasive taking the reaction.
+/// One abrasive–particle penalty contact (the paper's eqs. 12–14).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PenaltyContact {
+    /// Force on the SPH particle (N, or N/m when the mass is per unit depth); the grain takes
+    /// the opposite.
+    pub force_on_particle: Vector,
+    /// Contact point p on the grain's surface, where the grain's reaction acts (its torque is
+    /// (p − x_g) × (−force_on_particle), eq. 14).
+    pub point: Vector,
+}
+
+/// Penalty contact between an SPH target particle and an abrasive grain (the paper's eqs. 12–13).
 ///
-/// With d_p = |x_p − x_g| − R_g (particle to grain surface) and contact when d_p < `d_ini`:
-/// F^n = (1 − χ)(2 m_p/Δt²)(d_ini − d_p) n_p, n_p from the grain's centre to the particle, and
-/// F^t = −min(2 m_p/Δt |v_t|, μ |F^n|) sign(v_t) t_p, v_t the particle's tangential speed relative
-/// to the grain's surface point (the paper prints F^t without its sign; it must oppose sliding).
-/// `m_p` may be a mass per unit depth (the force is then per unit depth). `None` when apart.
+/// With d_p = |x_a − x_i| − R_i (particle a to the surface of grain i), contact when d_p < `d_ini`:
+/// F^n = (1 − χ)(2 m_a/Δt²)(d_ini − d_p) n_p, n_p from the grain's centre to the particle, and
+/// F^t = min(2 m_a/Δt |v_pa·t_p|, μ |F^n|) sign(v_pa·t_p) t_p, with v_pa = v_p − v_a the surface
+/// point's velocity relative to the particle (eq. 13 prints min() of a vector and a scalar; it is
+/// read as this magnitude cap with the direction of v_pa·t_p). `m_p` may be a mass per unit depth
+/// (the force is then per unit depth). `None` when apart.
 #[allow(clippy::too_many_arguments)]
 pub fn penalty_force(
     x_p: Vector,
@@ -118,7 +129,7 @@ pub fn penalty_force(
     chi: f64,
     friction: f64,
     dt: f64,
-) -> Option<Vector> {
+) -> Option<PenaltyContact> {
     let r = x_p - grain.pos;
     let dist = r.norm();
     let d_p = dist - grain.radius_m;
@@ -128,10 +139,13 @@ pub fn penalty_force(
     let n = r / dist;
     let t = perp(n);
     let surface_v = grain.vel + crate::math::omega_cross(grain.omega, n * grain.radius_m);
-    let v_t = (v_p - surface_v).dot(&t);
+    let v_t = (surface_v - v_p).dot(&t);
     let f_n = (1.0 - chi) * 2.0 * m_p / (dt * dt) * (d_ini - d_p);
     let f_t = (2.0 * m_p / dt * v_t.abs()).min(friction * f_n.abs());
-    Some(n * f_n - t * f_t.copysign(v_t))
+    Some(PenaltyContact {
+        force_on_particle: n * f_n + t * f_t.copysign(v_t),
+        point: grain.pos + n * grain.radius_m,
+    })
 }
 
 #[cfg(test)]
@@ -192,18 +206,36 @@ mod tests {
         let (m_p, d_ini, dt) = (1e-6, 5e-5, 1e-8);
         // Particle 20 µm off the surface along +y: inside the 50 µm range, overlap 30 µm.
         let x_p = Vector::new(0.0, 1.2e-4);
-        let f = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, 0.0, 0.3, dt).unwrap();
+        let c = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, 0.0, 0.3, dt).unwrap();
+        assert!((c.point - Vector::new(0.0, 1e-4)).norm() < 1e-18);
+        let f = c.force_on_particle;
         let expect = 2.0 * m_p / (dt * dt) * 3e-5;
         assert!((f.y / expect - 1.0).abs() < 1e-12 && f.x == 0.0);
         // Half of it with χ = 0.5.
-        let h = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, 0.5, 0.3, dt).unwrap();
+        let h = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, 0.5, 0.3, dt)
+            .unwrap()
+            .force_on_particle;
         assert!((h.y / (0.5 * expect) - 1.0).abs() < 1e-12);
         // Sliding fast along +x: friction along −x, capped at μ F^n.
-        let s = penalty_force(x_p, Vector::new(1e4, 0.0), m_p, &g, d_ini, 0.0, 0.3, dt).unwrap();
+        let s = penalty_force(x_p, Vector::new(1e4, 0.0), m_p, &g, d_ini, 0.0, 0.3, dt)
+            .unwrap()
+            .force_on_particle;
         assert!((s.x / (-0.3 * expect) - 1.0).abs() < 1e-12, "{s:?}");
         // Slow sliding: the force that stops it in half a step, below the cap.
-        let s = penalty_force(x_p, Vector::new(1e-3, 0.0), m_p, &g, d_ini, 0.0, 0.3, dt).unwrap();
+        let s = penalty_force(x_p, Vector::new(1e-3, 0.0), m_p, &g, d_ini, 0.0, 0.3, dt)
+            .unwrap()
+            .force_on_particle;
         assert!((s.x / (-2.0 * m_p / dt * 1e-3) - 1.0).abs() < 1e-12);
+        // A spinning grain drags a resting particle along its surface: ω > 0 moves the top
+        // point towards −x.
+        let spun = super::super::Grain {
+            omega: 1e5,
+            ..g.clone()
+        };
+        let d = penalty_force(x_p, Vector::zeros(), m_p, &spun, d_ini, 0.0, 0.3, dt)
+            .unwrap()
+            .force_on_particle;
+        assert!(d.x < 0.0, "{d:?}");
         // Out of range.
         let far = Vector::new(0.0, 1.6e-4);
         assert!(penalty_force(far, Vector::zeros(), m_p, &g, d_ini, 0.0, 0.3, dt).is_none());

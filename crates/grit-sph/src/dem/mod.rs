@@ -18,7 +18,7 @@ use crate::math::{cross, omega_cross, perp, Vector};
 
 pub use law::{
     contact_time, damping_ratio, dashpot, pair_stiffness, penalty_force, wall_stiffness,
-    ContactForce, SpringDashpot,
+    ContactForce, PenaltyContact, SpringDashpot,
 };
 
 /// The paper's DEM time-step factor α_tn in Δt ≤ (2π/α_tn) √(m/k_n).
@@ -101,30 +101,26 @@ impl Wall {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DemParams {
-    /// Young's modulus E of the grains (Pa), for k_n = 2 E_i R_i E_j R_j / (E_i R_i + E_j R_j).
+    /// Young's modulus E of the grains (Pa), for k_n = 2 E_i R_i E_j R_j / (E_i R_i + E_j R_j)
+    /// (the paper's eq. 10).
     pub youngs_modulus_pa: f64,
     /// Restitution coefficient e in (0, 1]; sets the damping ratio ξ.
     pub restitution: f64,
     /// Coulomb friction coefficient μ (–).
     pub friction: f64,
-    /// k_t / k_n; 2/7 gives a solid sphere equal normal and tangential periods.
-    #[serde(default = "default_kt_ratio")]
-    pub tangential_stiffness_ratio: f64,
-}
-
-fn default_kt_ratio() -> f64 {
-    2.0 / 7.0
+    /// Poisson's ratio ν of the grains: the paper's eq. 10 makes k_t = ν k_n for one material.
+    pub poisson_ratio: f64,
 }
 
 impl Default for DemParams {
-    /// The garnet-like abrasive (E 248 GPa); e and μ are this project's choices, the paper gives
-    /// none (docs/jet.md#dem-abrasives).
+    /// The paper's garnet-like abrasive (E 248 GPa, ν 0.3); e and μ are this project's choices,
+    /// the paper gives none (docs/jet.md#dem-abrasives).
     fn default() -> Self {
         DemParams {
             youngs_modulus_pa: 248e9,
+            poisson_ratio: 0.3,
             restitution: 0.8,
             friction: 0.3,
-            tangential_stiffness_ratio: default_kt_ratio(),
         }
     }
 }
@@ -133,10 +129,15 @@ impl DemParams {
     /// Checks every constant; errors name `dem.<field>` and the rule.
     pub fn validate(&self) -> Result<(), InputError> {
         InputError::require_positive("dem.youngs_modulus_pa", self.youngs_modulus_pa)?;
-        InputError::require_positive(
-            "dem.tangential_stiffness_ratio",
-            self.tangential_stiffness_ratio,
-        )?;
+        if !(self.poisson_ratio > 0.0 && self.poisson_ratio < 0.5) {
+            return Err(InputError::new(
+                "dem.poisson_ratio",
+                format!(
+                    "must lie in (0, 0.5) (k_t = ν k_n must be > 0), got {}",
+                    self.poisson_ratio
+                ),
+            ));
+        }
         if !(self.restitution > 0.0 && self.restitution <= 1.0) {
             return Err(InputError::new(
                 "dem.restitution",
@@ -152,7 +153,8 @@ impl DemParams {
         Ok(())
     }
 
-    /// Spring–dashpot of two grains (reduced mass, pair stiffness).
+    /// Spring–dashpot of two grains. The dashpot uses the reduced mass m* = m_i m_j/(m_i + m_j),
+    /// the mass for which the rebound has restitution e (the paper's eq. 11 writes m).
     pub fn pair_law(&self, a: &Grain, b: &Grain) -> SpringDashpot {
         let e = self.youngs_modulus_pa;
         let k_n = pair_stiffness(e, a.radius_m, e, b.radius_m);
@@ -170,7 +172,8 @@ impl DemParams {
 
     fn law(&self, k_n: f64, m_star: f64) -> SpringDashpot {
         let xi = damping_ratio(self.restitution);
-        let k_t = self.tangential_stiffness_ratio * k_n;
+        // Eq. 10's k_t with one E and ν for all grains (and a rigid wall) is ν k_n.
+        let k_t = self.poisson_ratio * k_n;
         SpringDashpot {
             k_n,
             d_n: dashpot(xi, m_star, k_n),

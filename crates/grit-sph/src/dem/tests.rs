@@ -263,7 +263,13 @@ fn external_force_accelerates_and_bad_input_is_named() {
             .field,
         "wall.normal"
     );
-    let json = r#"{"youngs_modulus_pa": 248e9, "restitution": 0.8, "friction": 0.3}"#;
+    let bad = DemParams {
+        poisson_ratio: 0.5,
+        ..DemParams::default()
+    };
+    let err = Dem::new(vec![], vec![], bad, Vector::zeros()).unwrap_err();
+    assert_eq!(err.field, "dem.poisson_ratio");
+    let json = r#"{"youngs_modulus_pa": 248e9, "poisson_ratio": 0.3, "restitution": 0.8, "friction": 0.3}"#;
     let p: DemParams = serde_json::from_str(json).unwrap();
     assert_eq!(p, DemParams::default());
 }
