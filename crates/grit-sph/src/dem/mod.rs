@@ -192,7 +192,7 @@ impl DemParams {
 }
 
 /// Which bodies a contact joins: two grains (lower index first) or a grain and a wall.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub enum ContactKey {
     /// Grains i < j.
     Pair(u32, u32),
@@ -214,10 +214,11 @@ pub struct ContactReport {
 }
 
 /// A set of grains and walls advanced together; loops run in grain index order, so a run is
-/// bit-for-bit repeatable.
-#[derive(Debug, Clone)]
+/// bit-for-bit repeatable, also across a checkpoint (serde) and resume.
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Dem {
-    /// The grains; their index is their identity in contacts.
+    /// The grains; their index is their identity in contacts. Append freely (an inlet); remove
+    /// only through [`Dem::retain`], which keeps the contact springs on the right grains.
     pub grains: Vec<Grain>,
     /// Fixed walls.
     pub walls: Vec<Wall>,
@@ -226,10 +227,54 @@ pub struct Dem {
     /// Gravity (m/s²).
     pub gravity: Vector,
     /// Tangential spring stretch δ_t per active contact; dropped when the contact opens.
+    #[serde(with = "spring_list")]
     springs: BTreeMap<ContactKey, f64>,
+    #[serde(skip)]
     reports: Vec<ContactReport>,
+    #[serde(skip)]
     force: Vec<Vector>,
+    #[serde(skip)]
     torque: Vec<f64>,
+}
+
+/// JSON maps need string keys: the springs travel as a list of (key, δ_t) in key order.
+mod spring_list {
+    use super::ContactKey;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use std::collections::BTreeMap;
+
+    pub fn serialize<S: Serializer>(
+        m: &BTreeMap<ContactKey, f64>,
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        m.iter().collect::<Vec<_>>().serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<BTreeMap<ContactKey, f64>, D::Error> {
+        Ok(Vec::<(ContactKey, f64)>::deserialize(d)?
+            .into_iter()
+            .collect())
+    }
+}
+
+fn validate_grain(i: usize, g: &Grain) -> Result<(), InputError> {
+    for (name, v) in [
+        ("radius_m", g.radius_m),
+        ("mass_kg", g.mass_kg),
+        ("inertia_kg_m2", g.inertia_kg_m2),
+    ] {
+        InputError::require_positive(format!("grains[{i}].{name}"), v)?;
+    }
+    let finite = [g.pos.x, g.pos.y, g.vel.x, g.vel.y, g.angle, g.omega];
+    if finite.iter().any(|v| !v.is_finite()) {
+        return Err(InputError::new(
+            format!("grains[{i}]"),
+            "position, velocity, angle and spin must be finite",
+        ));
+    }
+    Ok(())
 }
 
 impl Dem {
@@ -242,20 +287,7 @@ impl Dem {
     ) -> Result<Self, InputError> {
         params.validate()?;
         for (i, g) in grains.iter().enumerate() {
-            for (name, v) in [
-                ("radius_m", g.radius_m),
-                ("mass_kg", g.mass_kg),
-                ("inertia_kg_m2", g.inertia_kg_m2),
-            ] {
-                InputError::require_positive(format!("grains[{i}].{name}"), v)?;
-            }
-            let finite = [g.pos.x, g.pos.y, g.vel.x, g.vel.y, g.angle, g.omega];
-            if finite.iter().any(|v| !v.is_finite()) {
-                return Err(InputError::new(
-                    format!("grains[{i}]"),
-                    "position, velocity, angle and spin must be finite",
-                ));
-            }
+            validate_grain(i, g)?;
         }
         if grains.len() > u32::MAX as usize {
             return Err(InputError::new("grains", "at most 2^32 - 1 grains"));
@@ -270,6 +302,44 @@ impl Dem {
             springs: BTreeMap::new(),
             reports: Vec::new(),
         })
+    }
+
+    /// Adds a grain (an inlet), checked like those given to [`Dem::new`].
+    pub fn add(&mut self, g: Grain) -> Result<(), InputError> {
+        validate_grain(self.grains.len(), &g)?;
+        self.grains.push(g);
+        Ok(())
+    }
+
+    /// Keeps the grains for which `keep` is true (an outlet deletes the others), in their order;
+    /// the contact springs follow their grains to the new indices, those of removed grains go.
+    pub fn retain(&mut self, mut keep: impl FnMut(&Grain) -> bool) {
+        let mut new_index = vec![None; self.grains.len()];
+        let mut next = 0u32;
+        for (i, g) in self.grains.iter().enumerate() {
+            if keep(g) {
+                new_index[i] = Some(next);
+                next += 1;
+            }
+        }
+        let mut k = 0;
+        self.grains.retain(|_| {
+            k += 1;
+            new_index[k - 1].is_some()
+        });
+        let remap = |key: &ContactKey| match *key {
+            ContactKey::Pair(i, j) => Some(ContactKey::Pair(
+                new_index[i as usize]?,
+                new_index[j as usize]?,
+            )),
+            ContactKey::Wall(i, w) => Some(ContactKey::Wall(new_index[i as usize]?, w)),
+        };
+        self.springs = self
+            .springs
+            .iter()
+            .filter_map(|(key, d)| remap(key).map(|k| (k, *d)))
+            .collect();
+        self.reports.clear();
     }
 
     /// The contacts of the last step, in key order.
@@ -323,8 +393,13 @@ impl Dem {
 
     /// Fills `force`, `torque`, the contact reports, and advances the tangential springs.
     fn contact_forces(&mut self, dt: f64) {
-        self.force.iter_mut().for_each(|f| *f = Vector::zeros());
-        self.torque.iter_mut().for_each(|t| *t = 0.0);
+        // Sized here, not at construction: grains may have been added or the set restored from
+        // a checkpoint since the last step.
+        let n = self.grains.len();
+        self.force.clear();
+        self.force.resize(n, Vector::zeros());
+        self.torque.clear();
+        self.torque.resize(n, 0.0);
         self.reports.clear();
         let mut springs = BTreeMap::new();
         for (i, j) in self.candidate_pairs() {
