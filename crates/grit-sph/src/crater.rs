@@ -6,8 +6,11 @@
 //! caller may pass every live particle of the target or only its surface ones; detached
 //! fragments must be left out.
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::InputError;
 use crate::math::Vector;
+use crate::particles::Particles;
 
 /// How the profile is sampled.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,6 +50,50 @@ pub struct Crater {
     pub open: bool,
     /// The surface profile (x, y) of the topmost particle per column, left to right.
     pub profile: Vec<Vector>,
+}
+
+/// One point of a jet run's time series (the fields `grit jet --json` is to print).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CraterSample {
+    /// Simulated time (s).
+    pub t_s: f64,
+    /// Target mass removed so far, per metre of depth (kg/m).
+    pub mass_loss_kg_m: f64,
+    /// Cd (m).
+    pub crater_depth_m: f64,
+    /// Cw (m).
+    pub crater_width_m: f64,
+    /// Largest equivalent plastic strain left in the target (–).
+    pub max_plastic_strain: f64,
+}
+
+/// The time-series point of target body `body` at time `t_s`: Cd and Cw from its live
+/// particles, its largest plastic strain, and `mass_loss_kg_m` as the world booked it (the
+/// body's removed mass per unit depth).
+pub fn sample(
+    t_s: f64,
+    particles: &Particles,
+    body: u32,
+    mass_loss_kg_m: f64,
+    surface_y_m: f64,
+    opts: CraterOptions,
+) -> Result<CraterSample, InputError> {
+    let mut pos = Vec::new();
+    let mut max_eps = 0.0f64;
+    for (i, &b) in particles.body.iter().enumerate() {
+        if b == body {
+            pos.push(particles.pos[i]);
+            max_eps = max_eps.max(particles.eps_p[i]);
+        }
+    }
+    let c = crater(&pos, surface_y_m, opts)?;
+    Ok(CraterSample {
+        t_s,
+        mass_loss_kg_m,
+        crater_depth_m: c.depth_m,
+        crater_width_m: c.width_m,
+        max_plastic_strain: max_eps,
+    })
 }
 
 /// The topmost particle of each `bin_m`-wide column, columns centred on x_min + k·bin_m (so a
@@ -293,6 +340,44 @@ mod tests {
         let c = crater(&pts, 0.0, CraterOptions::for_spacing(S)).unwrap();
         assert!(c.open);
         assert!((c.width_m - 20.0 * S).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sample_reads_only_the_target_body() {
+        let target = block(30, |x| (5.0 * S * (1.0 - x.abs() / (10.0 * S))).max(0.0));
+        let mut p = Particles::default();
+        for (k, &x) in target.iter().enumerate() {
+            p.pos.push(x);
+            p.body.push(1);
+            p.eps_p.push(if k == 7 { 0.25 } else { 0.01 });
+        }
+        // A grain above the surface, with a larger strain, belongs to another body.
+        p.pos.push(Vector::new(0.0, 3.0 * S));
+        p.body.push(0);
+        p.eps_p.push(9.0);
+        let s = sample(1e-3, &p, 1, 2.5e-6, 0.0, CraterOptions::for_spacing(S)).unwrap();
+        assert!((s.crater_depth_m - 5.0 * S).abs() < 1e-15);
+        assert!((s.crater_width_m - 20.0 * S * (1.0 - 0.1)).abs() < 1e-12);
+        assert_eq!(
+            (s.t_s, s.mass_loss_kg_m, s.max_plastic_strain),
+            (1e-3, 2.5e-6, 0.25)
+        );
+        let json = serde_json::to_string(&s).unwrap();
+        for key in [
+            "t_s",
+            "mass_loss_kg_m",
+            "crater_depth_m",
+            "crater_width_m",
+            "max_plastic_strain",
+        ] {
+            assert!(json.contains(key), "{json}");
+        }
+        assert_eq!(
+            sample(0.0, &p, 7, 0.0, 0.0, CraterOptions::for_spacing(S))
+                .unwrap_err()
+                .field,
+            "crater.positions"
+        );
     }
 
     #[test]
