@@ -76,7 +76,7 @@ impl Grain {
 pub struct Wall {
     /// A point on the wall (m).
     pub point: Vector,
-    /// Unit normal pointing into the domain.
+    /// Unit normal pointing into the domain ([`Wall::new`] normalises it; [`Dem::new`] checks it).
     pub normal: Vector,
 }
 
@@ -288,6 +288,19 @@ impl Dem {
         params.validate()?;
         for (i, g) in grains.iter().enumerate() {
             validate_grain(i, g)?;
+        }
+        for (w, wall) in walls.iter().enumerate() {
+            let finite = wall
+                .point
+                .iter()
+                .chain(wall.normal.iter())
+                .all(|v| v.is_finite());
+            if !finite || (wall.normal.norm() - 1.0).abs() > 1e-9 {
+                return Err(InputError::new(
+                    format!("walls[{w}]"),
+                    "point must be finite and normal a unit vector (build it with Wall::new)",
+                ));
+            }
         }
         if grains.len() > u32::MAX as usize {
             return Err(InputError::new("grains", "at most 2^32 - 1 grains"));

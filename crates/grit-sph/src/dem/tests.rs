@@ -257,6 +257,17 @@ fn external_force_accelerates_and_bad_input_is_named() {
     g.radius_m = -1.0;
     let err = Dem::new(vec![g], vec![], DemParams::default(), Vector::zeros()).unwrap_err();
     assert_eq!(err.field, "grains[0].radius_m");
+    let skew = Wall {
+        point: Vector::zeros(),
+        normal: Vector::new(0.0, 2.0),
+    };
+    let err = Dem::new(
+        vec![],
+        vec![floor(), skew],
+        DemParams::default(),
+        Vector::zeros(),
+    );
+    assert_eq!(err.unwrap_err().field, "walls[1]");
     assert_eq!(
         Wall::new(Vector::zeros(), Vector::zeros())
             .unwrap_err()
