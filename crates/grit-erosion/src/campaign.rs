@@ -95,14 +95,16 @@ impl<T: Serialize> Serialize for Sweep<T> {
     }
 }
 
-/// The surface material: `"aisi304"` or a full `grit_sph::Material` object.
+/// The surface material: a preset name (`grit_sph::MATERIAL_NAMES`) or a full
+/// `grit_sph::Material` object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MaterialSpec(pub Material);
 
 impl Serialize for MaterialSpec {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        if self.0 == Material::aisi304() {
-            s.serialize_str("aisi304")
+        // A preset left unchanged is written by name, so stored specs stay short and readable.
+        if Material::by_name(&self.0.name).is_ok_and(|preset| preset == self.0) {
+            s.serialize_str(&self.0.name)
         } else {
             self.0.serialize(s)
         }
@@ -697,6 +699,25 @@ mod tests {
         assert_eq!(s, back);
         let d = CampaignSpec::default();
         assert_eq!(parse(&serde_json::to_string(&d).unwrap()).unwrap(), d);
+    }
+
+    #[test]
+    fn materials_by_name_read_and_write_as_names() {
+        let s = parse(r#"{"material": ["copper", "al6061", "aisi304"]}"#).unwrap();
+        let names: Vec<_> = s
+            .material
+            .values()
+            .iter()
+            .map(|m| m.0.name.clone())
+            .collect();
+        assert_eq!(names, ["copper", "al6061", "aisi304"]);
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(
+            json.contains(r#""material":["copper","al6061","aisi304"]"#),
+            "{json}"
+        );
+        let e = parse(r#"{"material": "brass"}"#).unwrap_err();
+        assert!(e.to_string().contains("brass") && e.to_string().contains("al6061"));
     }
 
     #[test]

@@ -4,13 +4,17 @@
 //! No I/O, no async: a `World` holds particles and bodies and advances them by `step()`.
 #![warn(missing_docs)]
 
+pub mod eos;
 pub mod error;
 pub mod material;
 
+pub use eos::{EquationOfState, MieGruneisen};
 pub use error::{InputError, SimError};
-pub use material::{JohnsonCook, JohnsonCookDamage, Material};
+pub use material::{JohnsonCook, JohnsonCookDamage, Material, MATERIAL_NAMES};
 pub mod body;
 pub mod contact;
+pub mod crater;
+pub mod dem;
 pub mod geometry;
 pub mod kernel;
 pub mod math;

@@ -1,9 +1,15 @@
 //! Elastic–plastic material data: linear elasticity, Johnson–Cook strength (eq. 18) and
 //! Johnson–Cook fracture (eqs. 19–20) of the seed paper; AISI 304 of its Table 1 is the default.
+//! The water-jet scene's metals (OFHC copper, Al 6061-T6) add a Mie–Grüneisen EOS
+//! (docs/jet.md#metal-targets).
 
 use serde::{Deserialize, Serialize};
 
+use crate::eos::{EquationOfState, MieGruneisen};
 use crate::error::InputError;
+
+/// Names [`Material::by_name`] knows, in the order error messages list them.
+pub const MATERIAL_NAMES: [&str; 3] = ["aisi304", "copper", "al6061"];
 
 /// Johnson–Cook metal with linear elasticity (seed Table 1 field meanings), SI units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -24,6 +30,10 @@ pub struct Material {
     pub plasticity: Option<JohnsonCook>,
     /// Johnson–Cook fracture parameters (eqs. 19–20); `None` disables damage.
     pub damage: Option<JohnsonCookDamage>,
+    /// Pressure law; `None` is the linear `p = K (ρ/ρ0 − 1)` of seed eq. 11 (and is left out of
+    /// the JSON, so materials stored before this field existed keep their bytes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eos: Option<EquationOfState>,
 }
 
 fn default_name() -> String {
@@ -97,6 +107,102 @@ impl Material {
                 d5: 0.0,
                 ref_strain_rate_s: 1e-3,
             }),
+            eos: None,
+        }
+    }
+
+    /// OFHC copper: Johnson–Cook strength and fracture, shock Mie–Grüneisen EOS
+    /// (constants and sources: docs/jet.md#metal-targets, docs/references.md).
+    pub fn copper() -> Self {
+        Material {
+            name: "copper".into(),
+            density_kg_m3: 8960.0,
+            youngs_modulus_pa: 124e9,
+            poisson_ratio: 0.34,
+            heat_capacity_j_kgk: 383.0,
+            plasticity: Some(JohnsonCook {
+                a_pa: 90e6,
+                b_pa: 292e6,
+                n: 0.31,
+                c: 0.025,
+                ref_strain_rate_s: 1.0,
+                m: 1.09,
+                t_ref_k: 293.0,
+                t_melt_k: 1356.0,
+            }),
+            damage: Some(JohnsonCookDamage {
+                d1: 0.54,
+                d2: 4.89,
+                d3: -3.03,
+                d4: 0.014,
+                d5: 1.12,
+                ref_strain_rate_s: 1.0,
+            }),
+            eos: Some(EquationOfState::MieGruneisen(MieGruneisen {
+                rho0_kg_m3: 8960.0,
+                c0_m_s: 3940.0,
+                s1: 1.49,
+                s2: 0.0,
+                s3: 0.0,
+                gamma0: 2.02,
+                a: 0.0,
+            })),
+        }
+    }
+
+    /// Aluminium alloy 6061-T6: Johnson–Cook strength and fracture, shock Mie–Grüneisen EOS
+    /// (constants and sources: docs/jet.md#metal-targets, docs/references.md).
+    pub fn al6061() -> Self {
+        Material {
+            name: "al6061".into(),
+            density_kg_m3: 2703.0,
+            youngs_modulus_pa: 68.9e9,
+            poisson_ratio: 0.33,
+            heat_capacity_j_kgk: 896.0,
+            plasticity: Some(JohnsonCook {
+                a_pa: 324e6,
+                b_pa: 114e6,
+                n: 0.42,
+                c: 0.002,
+                ref_strain_rate_s: 1.0,
+                m: 1.34,
+                t_ref_k: 293.0,
+                t_melt_k: 933.0,
+            }),
+            damage: Some(JohnsonCookDamage {
+                d1: -0.77,
+                d2: 1.45,
+                d3: -0.47,
+                d4: 0.0,
+                d5: 1.6,
+                ref_strain_rate_s: 1.0,
+            }),
+            eos: Some(EquationOfState::MieGruneisen(MieGruneisen {
+                rho0_kg_m3: 2703.0,
+                c0_m_s: 5350.0,
+                s1: 1.34,
+                s2: 0.0,
+                s3: 0.0,
+                gamma0: 2.0,
+                a: 0.0,
+            })),
+        }
+    }
+
+    /// The preset called `name` (one of [`MATERIAL_NAMES`]); an unknown name is an error that
+    /// names it and lists the known ones.
+    pub fn by_name(name: &str) -> Result<Self, InputError> {
+        match name {
+            "aisi304" => Ok(Self::aisi304()),
+            "copper" => Ok(Self::copper()),
+            "al6061" => Ok(Self::al6061()),
+            _ => Err(InputError::new(
+                "material",
+                format!(
+                    "unknown material `{name}`; known names: {}, or a full material object",
+                    MATERIAL_NAMES.join(", ")
+                ),
+            )),
         }
     }
 
@@ -110,6 +216,7 @@ impl Material {
             heat_capacity_j_kgk: 900.0,
             plasticity: None,
             damage: None,
+            eos: None,
         }
     }
 
@@ -194,6 +301,19 @@ impl Material {
             fin("damage.d5", d.d5)?;
             pos("damage.ref_strain_rate_s", d.ref_strain_rate_s)?;
         }
+        if let Some(eos) = &self.eos {
+            eos.validate("material.eos")?;
+            let rho0 = eos.reference_density();
+            if (rho0 / self.density_kg_m3 - 1.0).abs() > 1e-9 {
+                return Err(InputError::new(
+                    "material.eos.rho0_kg_m3",
+                    format!(
+                        "must equal material.density_kg_m3 ({}), got {rho0}",
+                        self.density_kg_m3
+                    ),
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -201,5 +321,116 @@ impl Material {
 impl Default for Material {
     fn default() -> Self {
         Self::aisi304()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_by_name_and_their_constants() {
+        for name in MATERIAL_NAMES {
+            let m = Material::by_name(name).unwrap();
+            assert_eq!(m.name, name);
+            m.validate().unwrap();
+        }
+        let cu = Material::copper();
+        let jc = cu.plasticity.as_ref().unwrap();
+        assert_eq!(
+            (jc.a_pa, jc.b_pa, jc.n, jc.c, jc.m),
+            (90e6, 292e6, 0.31, 0.025, 1.09)
+        );
+        assert_eq!((jc.ref_strain_rate_s, jc.t_melt_k), (1.0, 1356.0));
+        let d = cu.damage.as_ref().unwrap();
+        assert_eq!(
+            (d.d1, d.d2, d.d3, d.d4, d.d5),
+            (0.54, 4.89, -3.03, 0.014, 1.12)
+        );
+        let Some(EquationOfState::MieGruneisen(g)) = &cu.eos else {
+            panic!("copper has a Grüneisen EOS")
+        };
+        assert_eq!(
+            (g.rho0_kg_m3, g.c0_m_s, g.s1, g.gamma0),
+            (8960.0, 3940.0, 1.49, 2.02)
+        );
+
+        let al = Material::al6061();
+        let jc = al.plasticity.as_ref().unwrap();
+        assert_eq!(
+            (jc.a_pa, jc.b_pa, jc.n, jc.c, jc.m),
+            (324e6, 114e6, 0.42, 0.002, 1.34)
+        );
+        assert_eq!(jc.t_melt_k, 933.0);
+        let d = al.damage.as_ref().unwrap();
+        assert_eq!(
+            (d.d1, d.d2, d.d3, d.d4, d.d5),
+            (-0.77, 1.45, -0.47, 0.0, 1.6)
+        );
+        let Some(EquationOfState::MieGruneisen(g)) = &al.eos else {
+            panic!("al6061 has a Grüneisen EOS")
+        };
+        assert_eq!(
+            (g.rho0_kg_m3, g.c0_m_s, g.s1, g.gamma0),
+            (2703.0, 5350.0, 1.34, 2.0)
+        );
+    }
+
+    #[test]
+    fn linear_bulk_modulus_of_the_presets_is_near_the_shock_one() {
+        // The engine's linear law uses K from E and ν; the Grüneisen slope at rest is ρ0 c0².
+        // They are different measurements of one modulus, so they agree to ~15 %.
+        for m in [Material::copper(), Material::al6061()] {
+            let Some(EquationOfState::MieGruneisen(g)) = &m.eos else {
+                unreachable!()
+            };
+            let r = m.bulk_modulus() / g.bulk_modulus();
+            assert!((0.85..1.0).contains(&r), "{}: {r}", m.name);
+        }
+    }
+
+    #[test]
+    fn unknown_name_is_a_clear_error() {
+        let err = Material::by_name("brass").unwrap_err();
+        assert_eq!(err.field, "material");
+        assert!(err.rule.contains("`brass`"), "{}", err.rule);
+        for name in MATERIAL_NAMES {
+            assert!(err.rule.contains(name), "{}", err.rule);
+        }
+    }
+
+    #[test]
+    fn aisi304_json_has_no_eos_key_and_old_json_still_reads() {
+        let json = serde_json::to_string(&Material::aisi304()).unwrap();
+        assert_eq!(json, AISI304_JSON);
+        let back: Material = serde_json::from_str(AISI304_JSON).unwrap();
+        assert_eq!(back, Material::aisi304());
+        let cu = serde_json::to_string(&Material::copper()).unwrap();
+        assert!(cu.contains(r#""eos":{"kind":"mie_gruneisen""#), "{cu}");
+        assert_eq!(
+            serde_json::from_str::<Material>(&cu).unwrap(),
+            Material::copper()
+        );
+    }
+
+    /// AISI 304 as stored scenes held it before the EOS field existed.
+    const AISI304_JSON: &str = concat!(
+        r#"{"name":"aisi304","density_kg_m3":7890.0,"youngs_modulus_pa":200000000000.0,"#,
+        r#""poisson_ratio":0.3,"heat_capacity_j_kgk":510.0,"plasticity":{"a_pa":555500000.0,"#,
+        r#""b_pa":1379000000.0,"n":0.9497,"c":0.01503,"ref_strain_rate_s":0.0001,"m":1.3263,"#,
+        r#""t_ref_k":293.0,"t_melt_k":1673.0},"damage":{"d1":-0.7786,"d2":2.5588,"d3":-0.3607,"#,
+        r#""d4":-0.0191,"d5":0.0,"ref_strain_rate_s":0.001}}"#
+    );
+
+    #[test]
+    fn eos_density_must_match_the_material() {
+        let mut m = Material::copper();
+        m.density_kg_m3 = 8900.0;
+        assert_eq!(m.validate().unwrap_err().field, "material.eos.rho0_kg_m3");
+        let mut m = Material::al6061();
+        if let Some(EquationOfState::MieGruneisen(g)) = &mut m.eos {
+            g.s1 = f64::NAN;
+        }
+        assert_eq!(m.validate().unwrap_err().field, "material.eos.s1");
     }
 }

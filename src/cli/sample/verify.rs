@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use grit_sph::verification::{elastic_impact, hertz, hourglass, sliding, slope, CaseReport, Row};
+use grit_sph::verification::{
+    elastic_impact, hertz, hourglass, jet, sliding, slope, CaseReport, Row,
+};
 
 use crate::cli::output::say;
 
@@ -26,7 +28,7 @@ pub struct Args {
     #[arg(long)]
     charts: Option<PathBuf>,
     /// Run only the cases whose name contains this text (slope, sliding, hertz, impact,
-    /// hourglass).
+    /// hourglass, jet).
     #[arg(long)]
     only: Option<String>,
 }
@@ -45,14 +47,17 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         &[25, 35, 50]
     };
+    // The water-jet blocks' DEM rows, at the DEM step limit or half of it.
+    let jet_dt = if a.quick { 1.0 } else { 0.5 };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
-    let cases: [(&str, Case); 5] = [
+    let cases: [(&str, Case); 6] = [
         ("slope", Box::new(move || slope::run(slope_n))),
         ("sliding", Box::new(move || sliding::run(slide_n))),
         ("hertz", Box::new(move || hertz::run(hertz_n))),
         ("impact", Box::new(move || elastic_impact::run(impact_n))),
         ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
+        ("jet", Box::new(move || jet::run(jet_dt))),
     ];
     for (name, f) in cases.iter() {
         if !want(name) {

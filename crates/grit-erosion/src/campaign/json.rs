@@ -66,15 +66,14 @@ impl<'de> Deserialize<'de> for MaterialSpec {
         impl<'de> Visitor<'de> for MaterialVisitor {
             type Value = MaterialSpec;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("\"aisi304\" or a material object")
+                f.write_str(
+                    "a material name (\"aisi304\", \"copper\", \"al6061\") or a material object",
+                )
             }
             fn visit_str<E: de::Error>(self, name: &str) -> Result<MaterialSpec, E> {
-                match name {
-                    "aisi304" => Ok(MaterialSpec(Material::aisi304())),
-                    _ => Err(E::custom(format!(
-                        "unknown material `{name}`; expected \"aisi304\" or an object of Johnson–Cook and elastic constants"
-                    ))),
-                }
+                Material::by_name(name)
+                    .map(MaterialSpec)
+                    .map_err(|e| E::custom(e.rule))
             }
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<MaterialSpec, A::Error> {
                 Material::deserialize(MapAccessDeserializer::new(map)).map(MaterialSpec)
