@@ -97,6 +97,12 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
         "defaults filled in: {farm}"
     );
     assert_eq!(farm["grit_version"], env!("CARGO_PKG_VERSION"));
+    // The numerics the cells ran with, which the spec does not carry.
+    assert_eq!(
+        farm["numerics"]["cfl"],
+        grit_erosion::Numerics::default().engine.cfl,
+        "{farm}"
+    );
     assert_eq!(farm["steady"], Value::Bool(false));
     assert_eq!(
         farm["cells"][0]["steady_state"]["steady"],

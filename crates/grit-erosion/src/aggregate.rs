@@ -184,6 +184,10 @@ pub struct CampaignResults {
     /// Version of grit that aggregated these results; `null` in older files.
     #[serde(default)]
     pub grit_version: Option<String>,
+    /// The numerics every cell's impacts ran with, as stored with the cells when the campaign
+    /// was created (the spec does not set them: they are the defaults of that day's grit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub numerics: Option<crate::impact::Numerics>,
 }
 
 impl CampaignResults {
@@ -511,6 +515,7 @@ pub fn aggregate_campaign(
         steady: None,
         spec: None,
         grit_version: Some(env!("CARGO_PKG_VERSION").to_string()),
+        numerics: None,
     };
     results.steady = results.cells_steady();
     Ok(results)

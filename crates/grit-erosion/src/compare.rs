@@ -304,6 +304,7 @@ mod tests {
             steady: None,
             spec: None,
             grit_version: None,
+            numerics: None,
         }
     }
 

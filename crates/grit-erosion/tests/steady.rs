@@ -301,7 +301,7 @@ fn older_results_files_still_load() {
     for file in [
         "tests/data/quick-results.json",
         "tests/data/quick-raw-results.json",
-        "docs/erosion/reduced-results.json",
+        "docs/erosion/reduced-5samples-results.json",
     ] {
         let text = std::fs::read_to_string(format!("{root}/{file}")).unwrap();
         let r: CampaignResults = serde_json::from_str(&text).unwrap();

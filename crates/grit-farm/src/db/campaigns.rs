@@ -326,6 +326,18 @@ impl Store {
         let mut results = aggregate_campaign(&inputs, grit_erosion::SLOPE_WINDOW)
             .map_err(|e| Error::Internal(format!("aggregation: {e}")))?
             .with_spec(spec_value);
+        // The cells' stored scenes, not today's defaults, say how the impacts ran.
+        let params: Option<String> = sqlx::query_scalar(
+            "SELECT params FROM cells WHERE campaign_id = ? ORDER BY cell_index LIMIT 1",
+        )
+        .bind(id.to_string())
+        .fetch_optional(&self.read)
+        .await?;
+        if let Some(p) = params {
+            let p: grit_erosion::ImpactParams = serde_json::from_str(&p)
+                .map_err(|e| Error::Internal(format!("stored cell scene: {e}")))?;
+            results.numerics = Some(p.numerics);
+        }
         for (cell, plan) in results.cells.iter_mut().zip(&plans) {
             grit_erosion::campaign::annotate(cell, plan.until, plan.target);
         }
