@@ -345,48 +345,6 @@ pub(crate) fn stale(pos: &[Vector], x_build: &[Vector], half_skin: f64) -> bool 
         .any(|(x, x0)| (x - x0).norm_squared() > lim)
 }
 
-/// The particle order by body, then deformable particles by the Z-order (Morton) index of their
-/// neighbour-search cell of size `cell`, ties by current index; rigid bodies keep their order.
-/// `None` when the particles are in that order already.
-pub(crate) fn cell_order(p: &Particles, bodies: &[Body], cell: f64) -> Option<Vec<usize>> {
-    let n = p.len();
-    if n == 0 {
-        return None;
-    }
-    let lo = p.pos.iter().fold(p.pos[0], |a, x| a.inf(x));
-    let deformable: Vec<bool> = bodies.iter().map(|b| !b.is_rigid()).collect();
-    let key = |i: usize| -> u64 {
-        if !deformable[p.body[i] as usize] {
-            return 0;
-        }
-        let c = (p.pos[i] - lo) / cell;
-        // Cells past 2^31 along an axis (a particle flung far off) share the last one.
-        let ix = c.x.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
-        let iy = c.y.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
-        morton(ix, iy)
-    };
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&i| (p.body[i], key(i), i));
-    if order.iter().enumerate().all(|(k, &i)| k == i) {
-        return None;
-    }
-    Some(order)
-}
-
-/// Interleaves the bits of `x` and `y` (x in the even bits): the Z-order curve index of a cell.
-fn morton(x: u32, y: u32) -> u64 {
-    fn spread(v: u32) -> u64 {
-        let mut v = v as u64;
-        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
-        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
-        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
-        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
-        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
-        v
-    }
-    spread(x) | (spread(y) << 1)
-}
-
 /// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr,
 /// and the list's reference-distance mark.
 #[derive(Debug, Clone, Copy, Default)]

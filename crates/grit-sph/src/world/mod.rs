@@ -155,21 +155,13 @@ impl World {
         self.nbrs.pairs()
     }
 
-    /// Reach of the neighbour lists, and the cell size of the cell order: the kernel support
-    /// plus the Verlet skin.
+    /// Reach of the neighbour lists: the kernel support plus the Verlet skin.
     fn neighbour_reach(&self) -> f64 {
         self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m
     }
 
-    /// Rebuilds neighbour lists (`neighbours::build_for_bodies`), first putting the particles in
-    /// cell order where `Settings::cell_order` asks for it.
+    /// Rebuilds neighbour lists (`neighbours::build_for_bodies`).
     fn rebuild_neighbours(&mut self) {
-        if self.settings.cell_order {
-            let cell = self.neighbour_reach();
-            if let Some(order) = neighbours::cell_order(&self.particles, &self.bodies, cell) {
-                self.reorder_particles(&order);
-            }
-        }
         let radius = self.neighbour_reach();
         self.nbrs = neighbours::build_for_bodies(
             &self.particles,
