@@ -63,18 +63,26 @@ pub(crate) fn forces(
         .collect();
     // Particles whose force is used: kinematic ones follow their prescribed motion, and
     // fragments fly ballistically.
-    let active: Vec<bool> = (0..p.len())
-        .into_par_iter()
-        .par_tasks()
-        .map(|i| {
-            bc[p.body[i] as usize].deformable
-                && p.flags[i] & KINEMATIC == 0
-                && cache.count[i] >= MIN_SUPPORT_NEIGHBOURS
-        })
-        .collect();
+    let moving = |i: usize| bc[p.body[i] as usize].deformable && p.flags[i] & KINEMATIC == 0;
+    let is_active = |i: usize| moving(i) && cache.count[i] >= MIN_SUPPORT_NEIGHBOURS;
+    // A scene of rigid bodies alone has no same-body pairs: no pass over them.
+    let any_pairs = hi.start.last().is_some_and(|&s| s > 0);
+    let active: Vec<bool> = if any_pairs {
+        (0..p.len())
+            .into_par_iter()
+            .par_tasks()
+            .map(is_active)
+            .collect()
+    } else {
+        Vec::new()
+    };
     let hourglass_on = |pair: &HalfPair| alpha > 0.0 && pair.w > 0.0;
-    rows_mut(shared, &hi.start)
-        .into_par_iter()
+    let rows = if any_pairs {
+        rows_mut(shared, &hi.start)
+    } else {
+        Vec::new()
+    };
+    rows.into_par_iter()
         .par_tasks()
         .enumerate()
         .for_each(|(i, row)| {
@@ -119,10 +127,9 @@ pub(crate) fn forces(
         .into_par_iter()
         .par_tasks()
         .map(|i| {
-            if !active[i] {
-                let fragment = bc[p.body[i] as usize].deformable && p.flags[i] & KINEMATIC == 0;
+            if !is_active(i) {
                 return ParticleForce {
-                    acc: if fragment { g } else { Vector::zeros() },
+                    acc: if moving(i) { g } else { Vector::zeros() },
                     hourglass_work: 0.0,
                 };
             }

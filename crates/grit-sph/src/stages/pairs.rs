@@ -105,6 +105,9 @@ pub(crate) fn fill_half_pairs(
     k: &Kernel,
     half: &mut Vec<HalfPair>,
 ) {
+    if hi.start.last().is_none_or(|&s| s == 0) {
+        return;
+    }
     let r2max = k.radius() * k.radius();
     rows_mut(half, &hi.start)
         .into_par_iter()
