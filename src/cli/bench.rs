@@ -206,10 +206,6 @@ pub struct ImpactScene {
     /// first contact (the model before the flight skip).
     #[arg(long)]
     full_flight: bool,
-    /// Keep the surface's particles in Z-order of neighbour cells, re-sorted at every
-    /// neighbour rebuild (an option under test; results differ by rounding only).
-    #[arg(long)]
-    cell_order: bool,
 }
 
 /// Runs one `grit bench` subcommand.
@@ -294,7 +290,6 @@ fn impact(
         seed,
         full_grain,
         full_flight,
-        cell_order,
     } = scene;
     if threads == 0 {
         bail!("--threads: must be at least 1");
@@ -305,7 +300,6 @@ fn impact(
     let mut params = studies::scene(angle, spacing_m);
     params.numerics.engine.rigid_shell &= !full_grain;
     params.numerics.skip_flight &= !full_flight;
-    params.numerics.engine.cell_order |= cell_order;
     params.validate()?;
     let mut s = Sample::new(params, seed)?;
     for k in 0..after {
@@ -318,10 +312,9 @@ fn impact(
         return Ok(ExitCode::SUCCESS);
     }
     say!(
-        "scene: hexagon {angle} deg, 100 m/s, AISI 304, spacing {spacing_m:e} m, surface after {after} impacts, grain {}, flight {}, particles in {} order",
+        "scene: hexagon {angle} deg, 100 m/s, AISI 304, spacing {spacing_m:e} m, surface after {after} impacts, grain {}, flight {}",
         if full_grain { "filled" } else { "outline only" },
-        if full_flight { "simulated" } else { "skipped" },
-        if cell_order { "cell" } else { "creation" }
+        if full_flight { "simulated" } else { "skipped" }
     );
     say!("particles                 {}", b.particles);
     say!("steps                     {}", b.steps);

@@ -49,17 +49,17 @@ pub struct ImpactParams {
 /// vary; `Numerics::seed` holds the seed's sections 2–3, the default runs them at CFL 0.6.
 ///
 /// In JSON it keeps one flat object of the choices a scene may set (`NumericsJson`): the
-/// engine's `kernel`, `cfl`, `hourglass`, `contact_limits_dt`, `cell_order`, and `grain_shell`
-/// for its `rigid_shell`, beside the impact's own. The engine's other settings are not part of
-/// a scene, so stored scenes and checkpoints read and write the same bytes as ever.
+/// engine's `kernel`, `cfl`, `hourglass`, `contact_limits_dt`, and `grain_shell` for its
+/// `rigid_shell`, beside the impact's own. The engine's other settings are not part of a scene,
+/// so stored scenes and checkpoints read and write the same bytes as ever; the retired
+/// `cell_order` key is still written (as `false`) and read (either value, ignored).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(from = "NumericsJson", into = "NumericsJson")]
 pub struct Numerics {
     /// Engine settings: kernel (seed: quintic spline, eq. 4), Courant number, hourglass α of
     /// eq. 16, whether the contact springs may shorten the time step (off only in the stability
-    /// map), the grain as its outline particles only (`rigid_shell`: its mass and inertia come
-    /// from the polygon either way), and Z-order of the surface's particles (`cell_order`:
-    /// results differ by rounding only). Its `spacing_m` gives way to the scene's.
+    /// map), and the grain as its outline particles only (`rigid_shell`: its mass and inertia
+    /// come from the polygon either way). Its `spacing_m` gives way to the scene's.
     pub engine: Settings,
     /// Contact detection (seed: extrapolated distance and normal, eqs. 21–23).
     pub contact_model: ContactModel,
@@ -132,6 +132,9 @@ struct NumericsJson {
     contact_limits_dt: bool,
     grain_shell: bool,
     skip_flight: bool,
+    // The engine's Z-order re-sort of the surface's particles, deleted (docs/performance.md):
+    // it changed results by rounding only, so a scene stored with `true` reads as one without
+    // it. Written as `false` so that stored scenes keep their bytes.
     cell_order: bool,
     absorbing_layers: f64,
     // Absent, the filter keeps the seed's period in time at this scene's `cfl`; written only
@@ -158,7 +161,7 @@ impl From<Numerics> for NumericsJson {
             contact_limits_dt: n.engine.contact_limits_dt,
             grain_shell: n.engine.rigid_shell,
             skip_flight: n.skip_flight,
-            cell_order: n.engine.cell_order,
+            cell_order: false,
             absorbing_layers: n.absorbing_layers,
             shepard_interval: (n.engine.shepard_interval != filter_interval_in_time(n.engine.cfl))
                 .then_some(n.engine.shepard_interval),
@@ -175,7 +178,6 @@ impl From<NumericsJson> for Numerics {
                 hourglass: j.hourglass,
                 contact_limits_dt: j.contact_limits_dt,
                 rigid_shell: j.grain_shell,
-                cell_order: j.cell_order,
                 shepard_interval: j
                     .shepard_interval
                     .unwrap_or_else(|| filter_interval_in_time(j.cfl)),
@@ -905,6 +907,19 @@ mod tests {
         let n: Numerics = serde_json::from_str(r#"{"cfl": 0.2, "grain_shell": false}"#).unwrap();
         assert_eq!((n.engine.cfl, n.engine.rigid_shell), (0.2, false));
         assert!(serde_json::from_str::<Numerics>(r#"{"h_over_dx": 1.5}"#).is_err());
+    }
+
+    #[test]
+    fn scenes_stored_with_the_retired_cell_order_key_still_read() {
+        // The engine no longer re-sorts particles; either stored value reads as today's scene.
+        for v in ["false", "true"] {
+            let n: Numerics = serde_json::from_str(&format!(r#"{{"cell_order": {v}}}"#)).unwrap();
+            assert_eq!(n, Numerics::default());
+        }
+        let n: Numerics = serde_json::from_str(r#"{"cfl": 0.3, "cell_order": true}"#).unwrap();
+        assert!(serde_json::to_string(&n)
+            .unwrap()
+            .contains(r#""cell_order":false"#));
     }
 
     #[test]

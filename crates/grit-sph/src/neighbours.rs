@@ -1,7 +1,7 @@
 //! Cell-list neighbour search with a Verlet skin: lists hold every pair within
 //! support radius + skin and are reused until some particle has moved half the skin. Also which
-//! bodies' particles list each other, the optional cell ordering of the particles, and the
-//! same-body pair cache every SPH sum of a step reads.
+//! bodies' particles list each other, and which unordered pair each same-body entry is, so the
+//! SPH sums of a step evaluate each pair once.
 
 use rayon::prelude::*;
 
@@ -232,6 +232,8 @@ pub(crate) struct WorldLists {
     /// Same-body neighbours of every deformable particle (empty rows for rigid ones), with the
     /// reference-distance marks.
     pub same: NeighbourLists,
+    /// The unordered pair of each entry of `same`.
+    pub half: HalfIndex,
     /// For contact pair c, the primary boundary particles each secondary particle can touch.
     pub contact: Vec<ContactLists>,
 }
@@ -288,6 +290,7 @@ pub(crate) fn build_for_bodies(
         })
         .collect();
     same.near_ref = near_ref.concat();
+    let half = HalfIndex::new(&same);
     let contact = contacts
         .iter()
         .map(|c| {
@@ -333,7 +336,65 @@ pub(crate) fn build_for_bodies(
             }
         })
         .collect();
-    WorldLists { same, contact }
+    WorldLists {
+        same,
+        half,
+        contact,
+    }
+}
+
+/// The same-body pairs counted once each: pair (i, j) with i < j is kept in i's row, and both
+/// entries of it, i's and j's, name it by one id. A sum over pairs then evaluates each pair once
+/// and each particle gathers its pairs in its own row's order, so the sums keep a fixed order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct HalfIndex {
+    /// The pairs (i, j) with j > i have ids `start[i]..start[i + 1]`, in the order of i's row.
+    pub start: Vec<u32>,
+    /// Where the entries j > i begin in `list` for row i: rows are sorted by index, so those
+    /// entries close each row.
+    pub upper: Vec<u32>,
+    /// For each entry of the lists, the id of its pair.
+    pub id: Vec<u32>,
+}
+
+impl HalfIndex {
+    /// The index of same-body lists `nl`, which list j in i's row whenever they list i in j's
+    /// (the distance test and the cells are symmetric).
+    pub fn new(nl: &NeighbourLists) -> HalfIndex {
+        let n = nl.start.len().saturating_sub(1);
+        let upper: Vec<u32> = (0..n)
+            .map(|i| nl.start[i] + nl.of(i).partition_point(|&j| (j as usize) < i) as u32)
+            .collect();
+        let mut start = Vec::with_capacity(n + 1);
+        start.push(0u32);
+        for i in 0..n {
+            start.push(start[i] + (nl.start[i + 1] - upper[i]));
+        }
+        let id_of = |i: usize, k: usize| -> u32 {
+            let j = nl.list[k] as usize;
+            if j > i {
+                return start[i] + (k as u32 - upper[i]);
+            }
+            let at = nl
+                .of(j)
+                .binary_search(&(i as u32))
+                .expect("same-body lists are symmetric");
+            start[j] + (nl.start[j] + at as u32 - upper[j])
+        };
+        let id: Vec<u32> = (0..n)
+            .into_par_iter()
+            .flat_map_iter(|i| {
+                (nl.start[i] as usize..nl.start[i + 1] as usize).map(move |k| id_of(i, k))
+            })
+            .collect();
+        HalfIndex { start, upper, id }
+    }
+
+    /// The partners j > i of particle i, in row order: the pairs i holds, ids from `start[i]`.
+    #[inline]
+    pub fn upper_of<'a>(&self, nl: &'a NeighbourLists, i: usize) -> &'a [u32] {
+        &nl.list[self.upper[i] as usize..nl.start[i + 1] as usize]
+    }
 }
 
 /// Whether some particle has moved farther than `half_skin` from its position `x_build` at the
@@ -345,63 +406,19 @@ pub(crate) fn stale(pos: &[Vector], x_build: &[Vector], half_skin: f64) -> bool 
         .any(|(x, x0)| (x - x0).norm_squared() > lim)
 }
 
-/// The particle order by body, then deformable particles by the Z-order (Morton) index of their
-/// neighbour-search cell of size `cell`, ties by current index; rigid bodies keep their order.
-/// `None` when the particles are in that order already.
-pub(crate) fn cell_order(p: &Particles, bodies: &[Body], cell: f64) -> Option<Vec<usize>> {
-    let n = p.len();
-    if n == 0 {
-        return None;
-    }
-    let lo = p.pos.iter().fold(p.pos[0], |a, x| a.inf(x));
-    let deformable: Vec<bool> = bodies.iter().map(|b| !b.is_rigid()).collect();
-    let key = |i: usize| -> u64 {
-        if !deformable[p.body[i] as usize] {
-            return 0;
-        }
-        let c = (p.pos[i] - lo) / cell;
-        // Cells past 2^31 along an axis (a particle flung far off) share the last one.
-        let ix = c.x.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
-        let iy = c.y.clamp(0.0, u32::MAX as f64 / 2.0) as u32;
-        morton(ix, iy)
-    };
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&i| (p.body[i], key(i), i));
-    if order.iter().enumerate().all(|(k, &i)| k == i) {
-        return None;
-    }
-    Some(order)
-}
-
-/// Interleaves the bits of `x` and `y` (x in the even bits): the Z-order curve index of a cell.
-fn morton(x: u32, y: u32) -> u64 {
-    fn spread(v: u32) -> u64 {
-        let mut v = v as u64;
-        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
-        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
-        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
-        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
-        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
-        v
-    }
-    spread(x) | (spread(y) << 1)
-}
-
-/// A neighbour j of particle i in i's own body, with x_ij = x_i − x_j, r = |x_ij|, W_ij and dW/dr,
-/// and the list's reference-distance mark.
+/// A neighbour j of particle i in i's own body inside the kernel support, with
+/// x_ij = x_i − x_j and W_ij.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Pair {
     /// Index of the neighbour, 32 bits like the lists.
     pub j: u32,
     pub xij: Vector,
-    pub r: f64,
     pub w: f64,
-    pub dw: f64,
-    pub near_ref: bool,
 }
 
-/// The neighbours of `i` in the same-body lists `nl` with their kernel values: the loop every
-/// SPH sum of the deformable solid runs over (eqs. 8, 9, 12, 15, 6, 16), in the lists' fixed order.
+/// The neighbours of `i` in the same-body lists `nl` with their kernel values, in the lists'
+/// fixed order: the loop of the density filter (eq. 12), which runs after the particles have
+/// moved, so the step's pair cache no longer holds its pairs.
 pub(crate) fn body_pairs<'a>(
     p: &'a Particles,
     nl: &'a NeighbourLists,
@@ -410,68 +427,16 @@ pub(crate) fn body_pairs<'a>(
 ) -> impl Iterator<Item = Pair> + 'a {
     let xi = p.pos[i];
     let r2max = k.radius() * k.radius();
-    let s = nl.start[i] as usize;
-    nl.of(i)
-        .iter()
-        .zip(&nl.near_ref[s..])
-        .filter_map(move |(&j, &near_ref)| {
-            let xij = xi - p.pos[j as usize];
-            let r2 = xij.norm_squared();
-            // The lists reach a skin beyond the support; those pairs would add exact zeros.
-            if r2 >= r2max {
-                return None;
-            }
-            let r = r2.sqrt();
-            let (w, dw) = k.w_dw(r);
-            Some(Pair {
-                j,
-                xij,
-                r,
-                w,
-                dw,
-                near_ref,
-            })
-        })
-}
-
-/// A same-body pair inside the kernel support as the kernel sums leave it for the forces: the
-/// quotients dW/dr / r and x_ij / r are taken once here, so no later stage divides by r again
-/// (both are 0 for coincident particles, which every sum skips).
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct CachedPair {
-    /// Index of the neighbour, 32 bits like the lists: with the flag it fills the last word of
-    /// a 64-byte entry.
-    pub j: u32,
-    /// x_ij = x_i − x_j.
-    pub xij: Vector,
-    /// Unit vector x_ij / r.
-    pub e: Vector,
-    pub r: f64,
-    pub w: f64,
-    /// dW/dr / r: the kernel gradient is x_ij times this.
-    pub dw_r: f64,
-    /// Reference positions within the kernel support (`NeighbourLists::near_ref`).
-    pub near_ref: bool,
-}
-
-/// Same-body pairs of this step with their kernel values, in each particle's slice of the
-/// neighbour rows (first `count[i]` entries used): computed once in the kernel sums, read by the
-/// forces, so each pair's kernel is evaluated once per step.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct PairCache {
-    /// Pairs, laid out like the neighbour rows.
-    pub pairs: Vec<CachedPair>,
-    /// Pairs used in each particle's row.
-    pub count: Vec<u32>,
-}
-
-impl PairCache {
-    /// The cached same-body pairs of particle `i` (filled by the kernel sums this step).
-    #[inline]
-    pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [CachedPair] {
-        let s = nl.start[i] as usize;
-        &self.pairs[s..s + self.count[i] as usize]
-    }
+    nl.of(i).iter().filter_map(move |&j| {
+        let xij = xi - p.pos[j as usize];
+        let r2 = xij.norm_squared();
+        // The lists reach a skin beyond the support; those pairs would add exact zeros.
+        if r2 >= r2max {
+            return None;
+        }
+        let w = k.w(r2.sqrt());
+        Some(Pair { j, xij, w })
+    })
 }
 
 #[cfg(test)]
@@ -512,8 +477,34 @@ mod tests {
     }
 
     #[test]
-    fn cached_pair_fills_one_cache_line() {
-        assert_eq!(std::mem::size_of::<CachedPair>(), 64);
+    fn half_index_names_each_pair_once_from_both_ends() {
+        let pos: Vec<Vector> = (0..150)
+            .map(|k| {
+                Vector::new(
+                    (k % 15) as f64 * 0.5 + 0.01 * (k % 7) as f64,
+                    (k / 15) as f64 * 0.5,
+                )
+            })
+            .collect();
+        let all = vec![true; pos.len()];
+        let nl = build(&pos, &all, &all, 1.3, |i, j| (i + j) % 5 != 0);
+        let half = HalfIndex::new(&nl);
+        let pairs = *half.start.last().unwrap() as usize;
+        assert_eq!(2 * pairs, nl.pairs());
+        let mut ends = vec![Vec::new(); pairs];
+        for i in 0..pos.len() {
+            for (k, &j) in nl.of(i).iter().enumerate() {
+                ends[half.id[nl.start[i] as usize + k] as usize].push((i, j as usize));
+            }
+            for (t, &j) in half.upper_of(&nl, i).iter().enumerate() {
+                assert!(j as usize > i);
+                assert!(ends[half.start[i] as usize + t].contains(&(i, j as usize)));
+            }
+        }
+        for e in ends {
+            assert_eq!(e.len(), 2);
+            assert_eq!((e[0].0, e[0].1), (e[1].1, e[1].0));
+        }
     }
 
     #[test]

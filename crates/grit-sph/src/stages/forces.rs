@@ -3,9 +3,10 @@
 
 use rayon::prelude::*;
 
+use super::pairs::{rows_mut, HalfPair, PairCache, Side};
 use super::{ParTasks, SphView, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{Matrix, Vector};
-use crate::neighbours::{CachedPair, PairCache};
+use crate::neighbours::HalfIndex;
 use crate::particles::KINEMATIC;
 use crate::world::Settings;
 
@@ -15,13 +16,25 @@ struct ParticleForce {
     hourglass_work: f64,
 }
 
+/// The parts of a pair's forces that both its particles share, seen from the lower index i:
+/// (σ_i/(ρ_i²Γ_i) + σ_j/(ρ_j²Γ_j)) ∇W_ij of eq. 6, and the hourglass error of eq. 16, its
+/// stiffness and viscous parts, which does not depend on the side. Each particle scales them by
+/// its partner's mass and by the pair's volumes itself, as it would on its own.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PairForce {
+    stress: Vector,
+    hourglass: f64,
+}
+
 /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9, with the
 /// Shepard sums `sh`), the hourglass force (eq. 16, against the velocity gradients `gv`) and
 /// gravity, into `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes
-/// after the stress stage.
+/// after the stress stage. Each pair's shared terms are evaluated once (`hi`), and each particle
+/// gathers its pairs in its own row's order.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn forces(
     s: SphView<'_>,
+    hi: &HalfIndex,
     cache: &PairCache,
     vol: &[f64],
     sh: &[f64],
@@ -29,6 +42,7 @@ pub(crate) fn forces(
     settings: &Settings,
     dt: f64,
     accel: &mut Vec<Vector>,
+    shared: &mut Vec<PairForce>,
 ) -> f64 {
     let SphView { p, nl, k, bc } = s;
     let alpha = settings.hourglass;
@@ -47,57 +61,52 @@ pub(crate) fn forces(
             (p.sdev[i] - Matrix::identity() * pr) / (p.rho[i] * p.rho[i] * sh[i])
         })
         .collect();
-    let out: Vec<ParticleForce> = (0..p.len())
-        .into_par_iter()
+    // Particles whose force is used: kinematic ones follow their prescribed motion, and
+    // fragments fly ballistically.
+    let moving = |i: usize| bc[p.body[i] as usize].deformable && p.flags[i] & KINEMATIC == 0;
+    let is_active = |i: usize| moving(i) && cache.count[i] >= MIN_SUPPORT_NEIGHBOURS;
+    // A scene of rigid bodies alone has no same-body pairs: no pass over them.
+    let any_pairs = hi.start.last().is_some_and(|&s| s > 0);
+    let active: Vec<bool> = if any_pairs {
+        (0..p.len())
+            .into_par_iter()
+            .par_tasks()
+            .map(is_active)
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let hourglass_on = |pair: &HalfPair| alpha > 0.0 && pair.w > 0.0;
+    let rows = if any_pairs {
+        rows_mut(shared, &hi.start)
+    } else {
+        Vec::new()
+    };
+    rows.into_par_iter()
         .par_tasks()
-        .map(|i| {
-            let bi = p.body[i];
-            let c = bc[bi as usize];
-            // Kinematic particles follow their prescribed motion: their force is never used.
-            if !c.deformable || p.flags[i] & KINEMATIC != 0 {
-                return ParticleForce {
-                    acc: Vector::zeros(),
-                    hourglass_work: 0.0,
-                };
-            }
-            if cache.count[i] < MIN_SUPPORT_NEIGHBOURS {
-                return ParticleForce {
-                    acc: g,
-                    hourglass_work: 0.0,
-                };
-            }
-            let vi = p.vel[i];
-            let voli = vol[i];
-            let mut a = Vector::zeros();
-            let mut fhg = Vector::zeros();
-            for &CachedPair {
-                j,
-                xij,
-                e,
-                r,
-                w,
-                dw_r,
-                near_ref,
-            } in cache.of(nl, i)
-            {
-                if r == 0.0 {
+        .enumerate()
+        .for_each(|(i, row)| {
+            let js = hi.upper_of(nl, i);
+            let pairs = &cache.half[hi.start[i] as usize..];
+            let c = bc[p.body[i] as usize];
+            for ((out, &j), pair) in row.iter_mut().zip(js).zip(pairs) {
+                let j = j as usize;
+                if !pair.used || pair.r == 0.0 || !(active[i] || active[j]) {
                     continue;
                 }
-                let j = j as usize;
-                let grad = xij * dw_r;
-                a += (sig[i] + sig[j]) * grad * p.mass[j];
-                if alpha > 0.0 && w > 0.0 {
-                    // Not the kernel sums' volume: the stress stage has moved ρ since (continuity), and
-                    // both volumes must be the same step's for a symmetric pair force.
-                    let volj = vol[j];
-                    // Heavily sheared material can bring two particles almost on top of
-                    // each other; 1/r² then makes the pair force stiff enough to blow the
-                    // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
-                    // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
-                    let rr = r.max(HG_MIN_SEPARATION_H * h);
-                    let cij = alpha * voli * volj * w / (rr * rr);
+                let HalfPair {
+                    xij,
+                    e,
+                    r,
+                    dw_r,
+                    near_ref,
+                    ..
+                } = *pair;
+                let stress = (sig[i] + sig[j]) * (xij * dw_r);
+                let mut hourglass = 0.0;
+                if hourglass_on(pair) {
                     // Viscous part: velocity error against the mean velocity gradient.
-                    let vij = vi - p.vel[j];
+                    let vij = p.vel[i] - p.vel[j];
                     let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
                     let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
                     // Stiffness part: separation error against the mean deformation gradient.
@@ -108,7 +117,49 @@ pub(crate) fn forces(
                     } else {
                         0.0
                     };
-                    fhg -= e * (cij * 0.5 * (stiff + visc));
+                    hourglass = stiff + visc;
+                }
+                *out = PairForce { stress, hourglass };
+            }
+        });
+    let shared = &*shared;
+    let out: Vec<ParticleForce> = (0..p.len())
+        .into_par_iter()
+        .par_tasks()
+        .map(|i| {
+            if !is_active(i) {
+                return ParticleForce {
+                    acc: if moving(i) { g } else { Vector::zeros() },
+                    hourglass_work: 0.0,
+                };
+            }
+            let vi = p.vel[i];
+            let voli = vol[i];
+            let mut a = Vector::zeros();
+            let mut fhg = Vector::zeros();
+            for &Side { j, id } in cache.of(nl, i) {
+                let pair = cache.half[id as usize];
+                if pair.r == 0.0 {
+                    continue;
+                }
+                let flip = (j as usize) < i;
+                let j = j as usize;
+                let f = shared[id as usize];
+                let stress = if flip { -f.stress } else { f.stress };
+                a += stress * p.mass[j];
+                if hourglass_on(&pair) {
+                    // Not the kernel sums' volume: the stress stage has moved ρ since
+                    // (continuity), and both volumes must be the same step's for a symmetric
+                    // pair force.
+                    let volj = vol[j];
+                    // Heavily sheared material can bring two particles almost on top of
+                    // each other; 1/r² then makes the pair force stiff enough to blow the
+                    // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
+                    // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
+                    let rr = pair.r.max(HG_MIN_SEPARATION_H * h);
+                    let cij = alpha * voli * volj * pair.w / (rr * rr);
+                    let e = pair.seen(flip).e;
+                    fhg -= e * (cij * 0.5 * f.hourglass);
                 }
             }
             let acc = a + fhg / p.mass[i] + g;

@@ -1,12 +1,15 @@
 //! The kernel sums: Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator), Bonet–Lok correction
 //! matrices L_i (eq. 8) and the rates, the velocity gradients with the corrected kernel gradient
 //! (eqs. 15 and 7), in one pass over the pairs; and the same-body pair cache the forces read.
+//! Each pair's kernel is evaluated once (`pairs::fill_half_pairs`); each particle then sums its
+//! pairs in its own row's order.
 
 use rayon::prelude::*;
 
+use super::pairs::{fill_half_pairs, rows_mut, PairCache, Side};
 use super::{ParTasks, SphView, MIN_SUPPORT_NEIGHBOURS};
-use crate::math::{outer, Matrix, Vector};
-use crate::neighbours::{body_pairs, CachedPair, PairCache};
+use crate::math::{outer, Matrix};
+use crate::neighbours::HalfIndex;
 
 /// Per-particle results of the kernel sums, read by the later stages of the same step.
 #[derive(Debug, Clone, Default)]
@@ -33,28 +36,22 @@ struct ParticleSums {
 
 /// Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator), Bonet–Lok matrices L_i (eq. 8) and
 /// velocity gradients (eqs. 15 and 7) into `sums`; every same-body pair inside the support into
-/// `cache`. The velocity gradient of particle i needs only its own L_i, so it is summed in the
-/// same pass, term by term in the same order as a separate pass would.
-pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut KernelSums) {
+/// `cache`, evaluated once per pair (`hi`). The velocity gradient of particle i needs only its
+/// own L_i, so it is summed in the same pass, term by term in the same order as a separate pass
+/// would.
+pub(crate) fn kernel_sums(
+    s: SphView<'_>,
+    hi: &HalfIndex,
+    cache: &mut PairCache,
+    sums: &mut KernelSums,
+) {
     let SphView { p, nl, k, bc } = s;
     let w0 = k.w(0.0);
-    let n = p.len();
     super::volumes(p, &mut sums.vol);
     let vol = &sums.vol;
-    let buf = &mut cache.pairs;
-    // Rows are overwritten before they are read: grow, never clear (a memset per step).
-    if buf.len() < nl.list.len() {
-        buf.resize(nl.list.len(), CachedPair::default());
-    }
-    // One mutable slice per particle, so the rows fill in parallel, each by its own owner.
-    let mut rows: Vec<&mut [CachedPair]> = Vec::with_capacity(n);
-    let mut rest = buf.as_mut_slice();
-    for i in 0..n {
-        let (row, tail) = rest.split_at_mut(nl.of(i).len());
-        rows.push(row);
-        rest = tail;
-    }
-    let out: Vec<ParticleSums> = rows
+    fill_half_pairs(p, nl, hi, k, &mut cache.half);
+    let half = &cache.half;
+    let out: Vec<ParticleSums> = rows_mut(&mut cache.sides, &nl.start)
         .into_par_iter()
         .par_tasks()
         .enumerate()
@@ -73,31 +70,22 @@ pub(crate) fn kernel_sums(s: SphView<'_>, cache: &mut PairCache, sums: &mut Kern
             let vi = p.vel[i];
             let mut gv = Matrix::zeros();
             let mut cnt = 0;
-            for pair in body_pairs(p, nl, k, i) {
-                // Listed within the skin but outside the support: contributes nothing.
-                if pair.w == 0.0 && pair.dw == 0.0 {
+            let ids = &hi.id[nl.start[i] as usize..];
+            for (&j, &id) in nl.of(i).iter().zip(ids) {
+                let pair = half[id as usize];
+                if !pair.used {
                     continue;
                 }
-                let j = pair.j as usize;
+                let pair = pair.seen((j as usize) < i);
+                let j = j as usize;
                 let vj = vol[j];
                 g += vj * pair.w;
-                let (mut dw_r, mut e) = (0.0, Vector::zeros());
                 if pair.r > 0.0 {
-                    dw_r = pair.dw / pair.r;
-                    e = pair.xij / pair.r;
-                    let grad = pair.xij * dw_r;
+                    let grad = pair.xij * pair.dw_r;
                     m += outer(-pair.xij, grad) * vj;
                     gv += outer(p.vel[j] - vi, grad) * vj;
                 }
-                row[cnt] = CachedPair {
-                    j: pair.j,
-                    xij: pair.xij,
-                    e,
-                    r: pair.r,
-                    w: pair.w,
-                    dw_r,
-                    near_ref: pair.near_ref,
-                };
+                row[cnt] = Side { j: j as u32, id };
                 cnt += 1;
             }
             let lcorr = correction(m);

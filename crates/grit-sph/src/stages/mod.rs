@@ -7,15 +7,17 @@ mod density_filter;
 mod forces;
 mod integrate;
 mod kernel_sums;
+mod pairs;
 mod rigid;
 mod stress;
 mod time_step;
 
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
-pub(crate) use forces::forces;
+pub(crate) use forces::{forces, PairForce};
 pub(crate) use integrate::{integrate, Blowup};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};
+pub(crate) use pairs::PairCache;
 pub(crate) use rigid::rigid;
 pub(crate) use stress::stress;
 pub(crate) use time_step::stable_dt;

@@ -20,9 +20,11 @@ use crate::contact::{ContactPair, ContactParams};
 use crate::error::{InputError, SimError};
 use crate::kernel::Kernel;
 use crate::math::Vector;
-use crate::neighbours::{self, PairCache, WorldLists};
+use crate::neighbours::{self, WorldLists};
 use crate::particles::Particles;
-use crate::stages::{self, Blowup, BodyConst, KernelSums, PassedThrough, SphView};
+use crate::stages::{
+    self, Blowup, BodyConst, KernelSums, PairCache, PairForce, PassedThrough, SphView,
+};
 use crate::timers::{Stage, Timers};
 
 /// Scratch arrays rebuilt every step (not part of a checkpoint).
@@ -30,6 +32,8 @@ use crate::timers::{Stage, Timers};
 struct Scratch {
     /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
     pairs: PairCache,
+    /// The force terms each same-body pair's particles share (the forces fill it).
+    pair_forces: Vec<PairForce>,
     /// Volumes, Shepard sums, correction matrices and velocity gradients of the kernel sums.
     sums: KernelSums,
     /// Particle volumes after the stress stage: read by the forces, the contact and the density
@@ -155,21 +159,13 @@ impl World {
         self.nbrs.pairs()
     }
 
-    /// Reach of the neighbour lists, and the cell size of the cell order: the kernel support
-    /// plus the Verlet skin.
+    /// Reach of the neighbour lists: the kernel support plus the Verlet skin.
     fn neighbour_reach(&self) -> f64 {
         self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m
     }
 
-    /// Rebuilds neighbour lists (`neighbours::build_for_bodies`), first putting the particles in
-    /// cell order where `Settings::cell_order` asks for it.
+    /// Rebuilds neighbour lists (`neighbours::build_for_bodies`).
     fn rebuild_neighbours(&mut self) {
-        if self.settings.cell_order {
-            let cell = self.neighbour_reach();
-            if let Some(order) = neighbours::cell_order(&self.particles, &self.bodies, cell) {
-                self.reorder_particles(&order);
-            }
-        }
         let radius = self.neighbour_reach();
         self.nbrs = neighbours::build_for_bodies(
             &self.particles,
@@ -365,7 +361,8 @@ impl World {
             k: &self.kernel,
             bc,
         };
-        stages::kernel_sums(s, &mut self.scratch.pairs, &mut self.scratch.sums);
+        let (hi, sc) = (&self.nbrs.half, &mut self.scratch);
+        stages::kernel_sums(s, hi, &mut sc.pairs, &mut sc.sums);
     }
 
     fn stress(&mut self, bc: &[BodyConst], dt: f64) {
@@ -392,6 +389,7 @@ impl World {
         stages::volumes(s.p, &mut sc.vol);
         let hg = stages::forces(
             s,
+            &self.nbrs.half,
             &sc.pairs,
             &sc.vol,
             &sc.sums.shepard,
@@ -399,6 +397,7 @@ impl World {
             &self.settings,
             dt,
             &mut sc.acc,
+            &mut sc.pair_forces,
         );
         self.work.hourglass += hg;
     }

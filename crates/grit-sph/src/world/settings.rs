@@ -41,9 +41,6 @@ pub struct Settings {
     /// Rigid bodies keep only their outline layer of particles: interior particles of a rigid body are never searched, touched or summed, and its mass
     /// and inertia come from the polygon, so dropping them changes no result.
     pub rigid_shell: bool,
-    /// Deformable particles are re-sorted along a Z-order curve of neighbour cells at every
-    /// neighbour rebuild, so a particle's neighbours sit close to it in memory. Results change by rounding only: the sums run in another order.
-    pub cell_order: bool,
 }
 
 /// The largest Courant number `Settings` accepts.
@@ -66,7 +63,6 @@ impl Default for Settings {
             temperature_k: 293.0,
             contact_limits_dt: true,
             rigid_shell: false,
-            cell_order: false,
         }
     }
 }
