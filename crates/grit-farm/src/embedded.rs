@@ -117,6 +117,15 @@ pub async fn run(
     let spec_json = serde_json::to_string(spec)?;
     let key = format!("grit-run:{:016x}", fnv1a(spec_json.as_bytes()));
     let created = store.create_campaign(spec, Some(&key)).await?;
+    if !created.created {
+        // Running again continues the campaign. Jobs that failed here mostly lost their lease
+        // while the whole process was stopped or the machine slept (its own workers could not
+        // report), so each gets a fresh round of attempts, as `grit retry-failed` gives a farm.
+        let n = store.retry_failed(created.id).await?;
+        if n > 0 {
+            tracing::warn!("{n} failed jobs queued again");
+        }
+    }
     // Loopback only, with throwaway tokens: other local users cannot feed it results.
     let worker_token = uuid::Uuid::new_v4().to_string();
     let config = Config {
