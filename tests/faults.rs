@@ -487,3 +487,38 @@ async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed
     assert!(!log.contains("checkpoint unusable"), "{log}");
     assert_matches_grit_run(&c, id, dir.path(), &spec, 3).await;
 }
+
+/// A thousand simulated workers at once (`grit bench farm`): every request answered, none an
+/// error, and the figures the operator reads are all there.
+#[test]
+fn a_thousand_workers_at_once_get_no_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_grit"))
+        .args([
+            "bench",
+            "farm",
+            "--clients",
+            "1000",
+            "--seconds",
+            "3",
+            "--json",
+            "--dir",
+        ])
+        .arg(dir.path())
+        .output()
+        .expect("run grit bench farm");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let row = &rows[0];
+    assert_eq!(row["clients"], 1000, "{rows}");
+    assert_eq!(row["errors"], 0, "{rows}");
+    assert!(
+        row["claims_completions_per_s"].as_f64().unwrap() > 0.0,
+        "{rows}"
+    );
+    assert!(row["heartbeat_p99_ms"].as_f64().unwrap() > 0.0, "{rows}");
+}
