@@ -189,14 +189,9 @@ mod tests {
     use super::*;
 
     fn copper() -> MieGruneisen {
-        MieGruneisen {
-            rho0_kg_m3: 8960.0,
-            c0_m_s: 3940.0,
-            s1: 1.49,
-            s2: 0.0,
-            s3: 0.0,
-            gamma0: 2.02,
-            a: 0.0,
+        match crate::material::Material::copper().eos {
+            Some(EquationOfState::MieGruneisen(m)) => m,
+            other => panic!("copper's preset has no Mie–Grüneisen EOS: {other:?}"),
         }
     }
 

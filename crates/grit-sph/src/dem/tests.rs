@@ -67,14 +67,7 @@ fn dem_drop_contact_time_and_apex_heights() {
 
 /// Runs two grains head-on until they part; returns (relative speed ratio, contact time, dem).
 fn head_on(e: f64, params: DemParams) -> (f64, f64, Dem) {
-    let a = Grain {
-        vel: Vector::new(5.0, 0.0),
-        ..Grain::sphere(Vector::new(0.0, 0.0), 1e-4, 4120.0)
-    };
-    let b = Grain {
-        vel: Vector::new(-3.0, 0.0),
-        ..Grain::sphere(Vector::new(1.7e-4, 0.0), 0.6e-4, 4120.0)
-    };
+    let [a, b] = crate::verification::jet::head_on_grains();
     let params = DemParams {
         restitution: e,
         ..params

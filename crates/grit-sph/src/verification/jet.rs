@@ -204,18 +204,25 @@ fn ballistic_height(t: f64) -> f64 {
     }
 }
 
+/// The grains of `restitution`, about to meet head-on.
+pub(crate) fn head_on_grains() -> [Grain; 2] {
+    [
+        Grain {
+            vel: Vector::new(5.0, 0.0),
+            ..Grain::sphere(Vector::new(0.0, 0.0), 1e-4, 4120.0)
+        },
+        Grain {
+            vel: Vector::new(-3.0, 0.0),
+            ..Grain::sphere(Vector::new(1.7e-4, 0.0), 0.6e-4, 4120.0)
+        },
+    ]
+}
+
 /// Two unequal garnet-like grains head-on (radii 0.1 and 0.06 mm, 5 and −3 m/s): the relative
 /// rebound speed over the approach speed against e, and the contact time against
 /// π/(ω0 √(1 − ξ²)), ω0 = √(k_n/m*).
 pub fn restitution(e: f64, dt_scale: f64) -> Result<CaseReport, SimError> {
-    let a = Grain {
-        vel: Vector::new(5.0, 0.0),
-        ..Grain::sphere(Vector::new(0.0, 0.0), 1e-4, 4120.0)
-    };
-    let b = Grain {
-        vel: Vector::new(-3.0, 0.0),
-        ..Grain::sphere(Vector::new(1.7e-4, 0.0), 0.6e-4, 4120.0)
-    };
+    let [a, b] = head_on_grains();
     let params = DemParams {
         restitution: e,
         ..DemParams::default()
