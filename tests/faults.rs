@@ -522,3 +522,39 @@ fn a_thousand_workers_at_once_get_no_errors() {
     );
     assert!(row["heartbeat_p99_ms"].as_f64().unwrap() > 0.0, "{rows}");
 }
+
+/// `grit run` asleep: a process stopped (or a machine suspended) past the lease fails its own
+/// jobs, since its workers cannot heartbeat. Running `grit run` again gives the failed jobs a
+/// fresh round of attempts and ends with the same bits as a run that never failed.
+#[tokio::test(flavor = "multi_thread")]
+async fn grit_run_again_retries_jobs_failed_by_expired_leases() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec_text = campaign(2, 2);
+    let spec = grit_erosion::campaign::CampaignSpec::from_json(&spec_text).unwrap();
+    let out = dir.path().join("asleep");
+    std::fs::create_dir_all(&out).unwrap();
+    {
+        // The campaign as `grit run` stores it, with every lease expiring at once and three
+        // attempts, like the embedded coordinator's.
+        let store = grit_farm::Store::open(&out.join("grit.db"), Duration::from_millis(1), 3)
+            .await
+            .unwrap();
+        let key = grit_farm::embedded::campaign_key(&spec).unwrap();
+        let id = store.create_campaign(&spec, Some(&key)).await.unwrap().id;
+        let mut failed = 0;
+        for _ in 0..100 {
+            store.claim("asleep").await.unwrap().expect("a queued job");
+            tokio::time::sleep(Duration::from_millis(5)).await;
+            store.reap_expired().await.unwrap();
+            failed = store.status(id).await.unwrap().jobs.failed;
+            if failed > 0 {
+                break;
+            }
+        }
+        assert_eq!(failed, 1, "one job failed by three expired leases");
+    }
+    let again = grit_run(dir.path(), &spec_text, "asleep", true);
+    let clean = grit_run(dir.path(), &spec_text, "clean", true);
+    assert_bitwise_equal(&raw_series(&again), &raw_series(&clean));
+    assert_eq!(raw_series(&again).len(), 2, "both jobs ran");
+}

@@ -93,6 +93,13 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
+/// The idempotency key under which `grit run` stores `spec` in its database, so running the
+/// same spec again continues the same campaign.
+pub fn campaign_key(spec: &CampaignSpec) -> Result<String, serde_json::Error> {
+    let spec_json = serde_json::to_string(spec)?;
+    Ok(format!("grit-run:{:016x}", fnv1a(spec_json.as_bytes())))
+}
+
 /// Runs `spec` to the end (or until `stop`) and returns its results; `on_event` hears of the
 /// start, every status poll and anything worth a line.
 pub async fn run(
@@ -114,8 +121,7 @@ pub async fn run(
         })?;
     // Nothing else uses this file, so leases left by an interrupted run are dead.
     store.requeue_all_leases().await?;
-    let spec_json = serde_json::to_string(spec)?;
-    let key = format!("grit-run:{:016x}", fnv1a(spec_json.as_bytes()));
+    let key = campaign_key(spec)?;
     let created = store.create_campaign(spec, Some(&key)).await?;
     if !created.created {
         // Running again continues the campaign. Jobs that failed here mostly lost their lease
