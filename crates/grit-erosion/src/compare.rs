@@ -1,5 +1,6 @@
 //! A campaign's erosion beside the published references (Mohseni-Mofidi et al. 2022, section 4):
 //! erosion normalised at 45° against Oka's g(α) with silica exponents (eq. 35; Oka et al. 2005),
+//! the same g(α) with one scale fitted to all of a shape's angles,
 //! and erosion of each shape over the hexagon's at the same angle against the seed's
 //! shape-modified Oka h(e, An, α) (eqs. 37–38 with the exponents of Fig. 14).
 
@@ -67,6 +68,44 @@ pub struct ShapeRow {
     pub ratio: Ratio,
 }
 
+/// One cell against Oka's g(α) times the shape's fitted scale.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitRow {
+    /// Impact angle (degrees).
+    pub angle_deg: f64,
+    /// Cell erosion (mass lost / grain mass).
+    pub erosion: f64,
+    /// Standard error of `erosion`.
+    pub erosion_sem: f64,
+    /// Oka's g(α) times the fitted scale.
+    pub oka: f64,
+    /// erosion / oka − 1.
+    pub deviation: f64,
+    /// (erosion − oka) / erosion_sem.
+    pub z: f64,
+    /// Whether |deviation| is within the angle goal's tolerance.
+    pub within_goal: bool,
+    /// Whether the cell passed the steady-state check (`null`: not checked).
+    pub steady: Option<bool>,
+}
+
+/// One shape's angles against Oka's g(α) (eq. 35) with one scale fitted to all of them by
+/// weighted least squares (weights 1/s.e.²), so no single cell is the reference: Oka's model
+/// predicts the shape of E(α), not its size.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OkaFit {
+    /// Grain shape.
+    pub shape: String,
+    /// The fitted scale E ≈ scale · g(α) (mass lost / grain mass).
+    pub scale: f64,
+    /// Σ z² over the rows.
+    pub chi2: f64,
+    /// Degrees of freedom: rows − 1 (the scale).
+    pub dof: u32,
+    /// The cells, by angle.
+    pub rows: Vec<FitRow>,
+}
+
 /// Both tables and the angle of largest mean erosion per shape.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Comparison {
@@ -76,6 +115,9 @@ pub struct Comparison {
     pub oka_exponents: (f64, f64),
     /// Every cell that has its shape's 45° cell.
     pub angles: Vec<AngleRow>,
+    /// Per shape with two or more cells that have erosion and a standard error: Oka's g(α)
+    /// with a fitted scale.
+    pub oka_fits: Vec<OkaFit>,
     /// Every non-hexagon cell that has a hexagon cell at its angle.
     pub shapes: Vec<ShapeRow>,
     /// Per shape with three or more angles: the angle of its largest mean erosion.
@@ -170,6 +212,13 @@ pub fn compare(r: &CampaignResults) -> Comparison {
         .collect();
     let mut names: Vec<&str> = plain().map(|c| c.shape.as_str()).collect();
     names.dedup();
+    let oka_fits = names
+        .iter()
+        .filter_map(|s| {
+            let cells: Vec<&CellResult> = plain().filter(|c| c.shape == *s).collect();
+            oka_fit(s, &cells, |a| oka_g(a, n1, n2, hv))
+        })
+        .collect();
     let max_angle_deg = names
         .into_iter()
         .filter_map(|s| {
@@ -186,9 +235,52 @@ pub fn compare(r: &CampaignResults) -> Comparison {
         hv_gpa: hv,
         oka_exponents: (n1, n2),
         angles,
+        oka_fits,
         shapes,
         max_angle_deg,
     }
+}
+
+/// Oka's g(α) scaled to `cells` by weighted least squares: scale = Σ E g/σ² / Σ g²/σ² over the
+/// cells with erosion and a positive standard error; `None` below two such cells.
+fn oka_fit(shape: &str, cells: &[&CellResult], g: impl Fn(f64) -> f64) -> Option<OkaFit> {
+    let data: Vec<(&CellResult, f64, f64, f64)> = cells
+        .iter()
+        .filter_map(|c| match (c.erosion_mean, c.erosion_sem) {
+            (Some(e), Some(s)) if s > 0.0 => Some((*c, e, s, g(c.angle_deg))),
+            _ => None,
+        })
+        .collect();
+    if data.len() < 2 {
+        return None;
+    }
+    let num: f64 = data.iter().map(|(_, e, s, g)| e * g / (s * s)).sum();
+    let den: f64 = data.iter().map(|(_, _, s, g)| g * g / (s * s)).sum();
+    let scale = num / den;
+    let rows: Vec<FitRow> = data
+        .iter()
+        .map(|&(c, e, s, g)| {
+            let oka = scale * g;
+            let deviation = e / oka - 1.0;
+            FitRow {
+                angle_deg: c.angle_deg,
+                erosion: e,
+                erosion_sem: s,
+                oka,
+                deviation,
+                z: (e - oka) / s,
+                within_goal: deviation.abs() <= ANGLE_TOLERANCE,
+                steady: steady(c),
+            }
+        })
+        .collect();
+    Some(OkaFit {
+        shape: shape.to_string(),
+        scale,
+        chi2: rows.iter().map(|r| r.z * r.z).sum(),
+        dof: rows.len() as u32 - 1,
+        rows,
+    })
 }
 
 fn num(v: Option<f64>, digits: usize) -> String {
@@ -245,6 +337,35 @@ pub fn markdown(c: &Comparison) -> String {
             s,
             "{shape}: largest mean erosion at {angle}° (goal: between 30° and 45°)."
         );
+    }
+    for f in &c.oka_fits {
+        let _ = writeln!(
+            s,
+            "\n{}: Oka's g(α) scaled to all its angles by weighted least squares (scale {:.2} mg/g; χ² = {:.1} for {} degrees of freedom):\n",
+            f.shape,
+            1e3 * f.scale,
+            f.chi2,
+            f.dof
+        );
+        let _ = writeln!(
+            s,
+            "| angle | erosion (mg/g) ± s.e. | Oka, scaled | deviation | z | within goal | cell |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        for r in &f.rows {
+            let _ = writeln!(
+                s,
+                "| {}° | {:.2} ± {:.2} | {:.2} | {:+.0} % | {:.1} | {} | {} |",
+                r.angle_deg,
+                1e3 * r.erosion,
+                1e3 * r.erosion_sem,
+                1e3 * r.oka,
+                100.0 * r.deviation,
+                r.z,
+                if r.within_goal { "yes" } else { "**no**" },
+                yes_no(r.steady, "steady", "**unsteady**"),
+            );
+        }
     }
     if !c.shapes.is_empty() {
         let _ = writeln!(
@@ -367,6 +488,37 @@ mod tests {
             md.contains("| hexagon | 90° | 1.50 ± 0.30 | 0.75 ± 0.17 | 0.73 |"),
             "{md}"
         );
+    }
+
+    #[test]
+    fn oka_s_shape_with_a_fitted_scale_recovers_the_scale_and_weights_by_error() {
+        let hv = AISI304_HV_GPA;
+        let (n1, n2) = oka_silica_exponents(hv);
+        let g = |a: f64| oka_g(a, n1, n2, hv);
+        // Cells exactly on 2e-3 · g(α): the fit returns that scale with χ² = 0.
+        let exact: Vec<CellResult> = [15.0, 45.0, 90.0]
+            .iter()
+            .map(|&a| cell("hexagon", a, 2e-3 * g(a), 1e-4, true))
+            .collect();
+        let f = &compare(&results(exact)).oka_fits[0];
+        assert!((f.scale - 2e-3).abs() < 1e-15, "{f:?}");
+        assert!(f.chi2 < 1e-20 && f.dof == 2);
+        // One cell off by +20 % with a 10× larger error barely moves the scale.
+        let mut cells: Vec<CellResult> = [30.0, 60.0]
+            .iter()
+            .map(|&a| cell("hexagon", a, 2e-3 * g(a), 1e-5, true))
+            .collect();
+        cells.push(cell("hexagon", 90.0, 1.2 * 2e-3 * g(90.0), 1e-4, false));
+        let f = &compare(&results(cells)).oka_fits[0];
+        assert!((f.scale / 2e-3 - 1.0).abs() < 0.01, "{f:?}");
+        let off = f.rows.iter().find(|r| r.angle_deg == 90.0).unwrap();
+        assert!((off.deviation - 0.2).abs() < 0.01 && !off.within_goal);
+        assert_eq!(off.steady, Some(false));
+        let md = markdown(&compare(&results(vec![
+            cell("hexagon", 45.0, 2e-3, 2e-4, true),
+            cell("hexagon", 90.0, 1.5e-3, 3e-4, true),
+        ])));
+        assert!(md.contains("Oka's g(α) scaled to all its angles"), "{md}");
     }
 
     #[test]
