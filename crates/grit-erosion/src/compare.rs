@@ -291,18 +291,26 @@ fn yes_no(v: Option<bool>, yes: &str, no: &str) -> String {
     v.map_or("not checked".into(), |b| (if b { yes } else { no }).into())
 }
 
-fn ratio_cells(r: &Ratio) -> String {
-    format!(
-        "{} ± {} | {:.2} | {} | {} | {} | {}",
-        num(r.value, 2),
-        num(r.sem, 2),
-        r.reference,
+/// A ratio's table cells: value ± s.e., reference, deviation, z, goal and steadiness.
+fn ratio_cells(r: &Ratio) -> [String; 6] {
+    [
+        format!("{} ± {}", num(r.value, 2), num(r.sem, 2)),
+        format!("{:.2}", r.reference),
         r.deviation
             .map_or("–".into(), |d| format!("{:+.0} %", 100.0 * d)),
         num(r.z, 1),
         yes_no(r.within_goal, "yes", "**no**"),
         yes_no(r.steady, "steady", "**unsteady**"),
-    )
+    ]
+}
+
+/// A Markdown table: `head` names the columns, each row gives their cells.
+fn table(s: &mut String, head: &[&str], rows: impl IntoIterator<Item = Vec<String>>) {
+    let _ = writeln!(s, "| {} |", head.join(" | "));
+    let _ = writeln!(s, "|{}", "---|".repeat(head.len()));
+    for row in rows {
+        let _ = writeln!(s, "| {} |", row.join(" | "));
+    }
 }
 
 /// The comparison as Markdown tables, for `docs/erosion.md` and the terminal.
@@ -316,19 +324,33 @@ pub fn markdown(c: &Comparison) -> String {
         c.hv_gpa,
         100.0 * ANGLE_TOLERANCE
     );
-    let _ = writeln!(s, "| shape | angle | erosion (mg/g) ± s.e. | E/E(45°) ± s.e. | Oka | deviation | z | within goal | cells |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
-    for a in &c.angles {
-        let _ = writeln!(
-            s,
-            "| {} | {}° | {} ± {} | {} |",
-            a.shape,
-            a.angle_deg,
-            num(a.erosion.map(|e| 1e3 * e), 2),
-            num(a.erosion_sem.map(|e| 1e3 * e), 2),
-            ratio_cells(&a.ratio)
-        );
-    }
+    table(
+        &mut s,
+        &[
+            "shape",
+            "angle",
+            "erosion (mg/g) ± s.e.",
+            "E/E(45°) ± s.e.",
+            "Oka",
+            "deviation",
+            "z",
+            "within goal",
+            "cells",
+        ],
+        c.angles.iter().map(|a| {
+            let mut row = vec![
+                a.shape.clone(),
+                format!("{}°", a.angle_deg),
+                format!(
+                    "{} ± {}",
+                    num(a.erosion.map(|e| 1e3 * e), 2),
+                    num(a.erosion_sem.map(|e| 1e3 * e), 2)
+                ),
+            ];
+            row.extend(ratio_cells(&a.ratio));
+            row
+        }),
+    );
     if !c.max_angle_deg.is_empty() {
         s.push('\n');
     }
@@ -347,25 +369,29 @@ pub fn markdown(c: &Comparison) -> String {
             f.chi2,
             f.dof
         );
-        let _ = writeln!(
-            s,
-            "| angle | erosion (mg/g) ± s.e. | Oka, scaled | deviation | z | within goal | cell |"
+        table(
+            &mut s,
+            &[
+                "angle",
+                "erosion (mg/g) ± s.e.",
+                "Oka, scaled",
+                "deviation",
+                "z",
+                "within goal",
+                "cell",
+            ],
+            f.rows.iter().map(|r| {
+                vec![
+                    format!("{}°", r.angle_deg),
+                    format!("{:.2} ± {:.2}", 1e3 * r.erosion, 1e3 * r.erosion_sem),
+                    format!("{:.2}", 1e3 * r.oka),
+                    format!("{:+.0} %", 100.0 * r.deviation),
+                    format!("{:.1}", r.z),
+                    yes_no(Some(r.within_goal), "yes", "**no**"),
+                    yes_no(r.steady, "steady", "**unsteady**"),
+                ]
+            }),
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
-        for r in &f.rows {
-            let _ = writeln!(
-                s,
-                "| {}° | {:.2} ± {:.2} | {:.2} | {:+.0} % | {:.1} | {} | {} |",
-                r.angle_deg,
-                1e3 * r.erosion,
-                1e3 * r.erosion_sem,
-                1e3 * r.oka,
-                100.0 * r.deviation,
-                r.z,
-                if r.within_goal { "yes" } else { "**no**" },
-                yes_no(r.steady, "steady", "**unsteady**"),
-            );
-        }
     }
     if !c.shapes.is_empty() {
         let _ = writeln!(
@@ -373,20 +399,24 @@ pub fn markdown(c: &Comparison) -> String {
             "\nErosion over the hexagon's at the same angle against the seed's modified Oka h(e, An, α) (eq. 38, Fig. 14 exponents; goal ±{:.0} %):\n",
             100.0 * SHAPE_TOLERANCE
         );
-        let _ = writeln!(
-            s,
-            "| angle | shape | E/E(hexagon) ± s.e. | seed | deviation | z | within goal | cells |"
+        table(
+            &mut s,
+            &[
+                "angle",
+                "shape",
+                "E/E(hexagon) ± s.e.",
+                "seed",
+                "deviation",
+                "z",
+                "within goal",
+                "cells",
+            ],
+            c.shapes.iter().map(|r| {
+                let mut row = vec![format!("{}°", r.angle_deg), r.shape.clone()];
+                row.extend(ratio_cells(&r.ratio));
+                row
+            }),
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
-        for r in &c.shapes {
-            let _ = writeln!(
-                s,
-                "| {}° | {} | {} |",
-                r.angle_deg,
-                r.shape,
-                ratio_cells(&r.ratio)
-            );
-        }
     }
     s
 }
