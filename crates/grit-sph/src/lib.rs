@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod eos;
+pub mod fluid;
 pub mod error;
 pub mod material;
 
