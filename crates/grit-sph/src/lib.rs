@@ -14,6 +14,7 @@ pub use error::{InputError, SimError};
 pub use material::{JohnsonCook, JohnsonCookDamage, Material, MATERIAL_NAMES};
 pub mod body;
 pub mod contact;
+pub mod coupling;
 pub mod crater;
 pub mod dem;
 pub mod geometry;
