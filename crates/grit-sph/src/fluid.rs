@@ -43,7 +43,14 @@ impl ArtificialViscosity {
     /// (−α c̄ φ + β φ²)/ρ̄_ab for approaching pairs (v_ab·x_ab < 0), 0 otherwise, with
     /// φ = h̄ v_ab·x_ab/(|x_ab|² + (0.1 h̄)²). Symmetric in a and b.
     #[inline]
-    pub fn pi_ab(&self, x_ab: Vector, v_ab: Vector, c_mean: f64, rho_mean: f64, h_mean: f64) -> f64 {
+    pub fn pi_ab(
+        &self,
+        x_ab: Vector,
+        v_ab: Vector,
+        c_mean: f64,
+        rho_mean: f64,
+        h_mean: f64,
+    ) -> f64 {
         let vx = v_ab.dot(&x_ab);
         if vx >= 0.0 {
             return 0.0;
@@ -190,7 +197,13 @@ pub fn grad_w(kernel: &Kernel, x_ab: Vector) -> Vector {
 /// Particle a's continuity rate term ρ̄_a (m_b/ρ̄_b) v_ab·∇_a W_ab (kg/(m³·s) in 2D per metre of
 /// depth), the AWJ paper eq. 22 with porosity-weighted densities ρ̄ = ε ρ.
 #[inline]
-pub fn continuity_rate(rho_bar_a: f64, m_b: f64, rho_bar_b: f64, v_ab: Vector, grad: Vector) -> f64 {
+pub fn continuity_rate(
+    rho_bar_a: f64,
+    m_b: f64,
+    rho_bar_b: f64,
+    v_ab: Vector,
+    grad: Vector,
+) -> f64 {
     rho_bar_a * (m_b / rho_bar_b) * v_ab.dot(&grad)
 }
 

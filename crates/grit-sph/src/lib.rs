@@ -5,11 +5,12 @@
 #![warn(missing_docs)]
 
 pub mod eos;
-pub mod fluid;
 pub mod error;
+pub mod fluid;
 pub mod material;
 
 pub use eos::{EquationOfState, MieGruneisen};
+pub use fluid::{Fluid, FLUID_NAMES};
 pub use error::{InputError, SimError};
 pub use material::{JohnsonCook, JohnsonCookDamage, Material, MATERIAL_NAMES};
 pub mod body;

@@ -10,9 +10,8 @@
 mod drag;
 
 pub use drag::{
-    drag_coefficient, drag_coefficient_times_re, drag_per_volume, reynolds,
-    stokes_relaxation_time, stokes_velocity, terminal_velocity, Settling, DEFAULT_SWITCH_POROSITY,
-    NEWTON_REYNOLDS,
+    drag_coefficient, drag_coefficient_times_re, drag_per_volume, reynolds, stokes_relaxation_time,
+    stokes_velocity, terminal_velocity, Settling, DEFAULT_SWITCH_POROSITY, NEWTON_REYNOLDS,
 };
 
 use serde::{Deserialize, Serialize};

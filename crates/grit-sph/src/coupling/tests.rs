@@ -64,7 +64,10 @@ fn ergun_and_wen_yu_meet_with_a_jump_at_the_switch() {
     let ergun0 = at(s, 0.0) * D * D / mu;
     let wenyu0 = at(s + 1e-12, 0.0) * D * D / mu;
     assert!((ergun0 - 37.5).abs() < 1e-9, "{ergun0}");
-    assert!((wenyu0 - 18.0 * 0.8f64.powf(-2.65)).abs() < 1e-6, "{wenyu0}");
+    assert!(
+        (wenyu0 - 18.0 * 0.8f64.powf(-2.65)).abs() < 1e-6,
+        "{wenyu0}"
+    );
     assert!((ergun0 / wenyu0 - 1.1533).abs() < 1e-3);
     // Inertial flow (Re ≫ 1000): Ergun's 1.75 against Wen–Yu's 0.33 ε^−1.65 (× ρ|v|/d).
     let v = 1e3;
@@ -85,8 +88,14 @@ fn settling_reproduces_stokes_at_small_re_and_the_garnet_reference() {
     let s = terminal_velocity(RHO_P, d, 1.0, &w, 9.81, DEFAULT_SWITCH_POROSITY).unwrap();
     let stokes = stokes_velocity(RHO_P, d, &w, 9.81);
     assert!(s.reynolds < 0.01, "{s:?}");
-    assert!((s.velocity_m_s / stokes - 1.0).abs() < 0.01, "{s:?} vs {stokes}");
-    assert!(s.velocity_m_s < stokes, "Schiller–Naumann drags more than Stokes");
+    assert!(
+        (s.velocity_m_s / stokes - 1.0).abs() < 0.01,
+        "{s:?} vs {stokes}"
+    );
+    assert!(
+        s.velocity_m_s < stokes,
+        "Schiller–Naumann drags more than Stokes"
+    );
     // The paper's abrasive (d = 0.2 mm) settles at 0.0414 m/s (Re 8.3), 39 % below Stokes.
     let s = terminal_velocity(RHO_P, D, 1.0, &w, 9.81, DEFAULT_SWITCH_POROSITY).unwrap();
     assert!((s.velocity_m_s - 0.04144).abs() < 1e-5, "{s:?}");
@@ -161,7 +170,10 @@ fn porosity_recovers_the_grain_area_and_is_floored() {
     assert_eq!(eps.floored, 0);
     let displaced: f64 = eps.values.iter().map(|e| (1.0 - e) * DX * DX).sum();
     let solid = 3.0 * disc_area(0.5 * D);
-    assert!((displaced / solid - 1.0).abs() < 0.01, "{displaced} vs {solid}");
+    assert!(
+        (displaced / solid - 1.0).abs() < 0.01,
+        "{displaced} vs {solid}"
+    );
     // A lone grain at R_c = 2 d leaves ε = 1 − (10/7π) π/4 = 0.643 at its centre.
     let centre = fluid
         .iter()
@@ -177,13 +189,19 @@ fn porosity_recovers_the_grain_area_and_is_floored() {
     let eps = porosity(&tight, fluid.len(), &grains[..1], &pairs);
     assert!(eps.floored > 0);
     assert_eq!(eps.values[centre], tight.min_porosity);
-    assert!(eps.values.iter().all(|&e| e >= tight.min_porosity && e <= 1.0));
+    assert!(eps
+        .values
+        .iter()
+        .all(|&e| e >= tight.min_porosity && e <= 1.0));
 }
 
 #[test]
 fn pairs_are_those_within_rc_in_grain_then_fluid_order() {
     let fluid = block(40);
-    let grains = vec![grain(0.9e-3, 0.5e-3, 0.0, 0.0), grain(0.2e-3, 1.1e-3, 0.0, 0.0)];
+    let grains = vec![
+        grain(0.9e-3, 0.5e-3, 0.0, 0.0),
+        grain(0.2e-3, 1.1e-3, 0.0, 0.0),
+    ];
     let p = CouplingParams::default();
     let pairs = find_pairs(&p, &fluid, &grains).unwrap();
     let mut brute = Vec::new();
@@ -250,8 +268,16 @@ fn action_equals_minus_reaction_to_rounding() {
         mass: &mass,
         rho_bar: &rho_bar,
     };
-    let f = coupling_forces(&p, &Fluid::water(), view, &eps.values, &theta, &grains, &pairs)
-        .unwrap();
+    let f = coupling_forces(
+        &p,
+        &Fluid::water(),
+        view,
+        &eps.values,
+        &theta,
+        &grains,
+        &pairs,
+    )
+    .unwrap();
     let on_grains: Vector = f.on_grains.iter().sum();
     let on_fluid: Vector = f.on_fluid.iter().sum();
     let scale: f64 = f.on_grains.iter().map(|v| v.norm()).sum();
@@ -323,27 +349,59 @@ fn grains_out_of_the_fluid_feel_nothing_and_bad_slices_are_named() {
         mass: &mass,
         rho_bar: &rho_bar,
     };
-    let f = coupling_forces(&p, &Fluid::water(), view, &eps.values, &theta, &grains, &pairs)
-        .unwrap();
+    let f = coupling_forces(
+        &p,
+        &Fluid::water(),
+        view,
+        &eps.values,
+        &theta,
+        &grains,
+        &pairs,
+    )
+    .unwrap();
     assert_eq!(f.on_grains[0], Vector::zeros());
     assert_eq!(f.grain_fluid[0].porosity, 1.0);
     assert!(f.on_fluid.iter().all(|v| *v == Vector::zeros()));
-    let e = coupling_forces(&p, &Fluid::water(), view, &eps.values[1..], &theta, &grains, &pairs)
-        .unwrap_err();
+    let e = coupling_forces(
+        &p,
+        &Fluid::water(),
+        view,
+        &eps.values[1..],
+        &theta,
+        &grains,
+        &pairs,
+    )
+    .unwrap_err();
     assert_eq!(e.field, "porosity");
     let short = FluidView {
         mass: &mass[1..],
         ..view
     };
-    let e = coupling_forces(&p, &Fluid::water(), short, &eps.values, &theta, &grains, &pairs)
-        .unwrap_err();
+    let e = coupling_forces(
+        &p,
+        &Fluid::water(),
+        short,
+        &eps.values,
+        &theta,
+        &grains,
+        &pairs,
+    )
+    .unwrap_err();
     assert_eq!(e.field, "fluid.mass");
     let stray = [Pair {
         grain: 3,
         fluid: 0,
         w: 1.0,
     }];
-    let e = coupling_forces(&p, &Fluid::water(), view, &eps.values, &theta, &grains, &stray)
-        .unwrap_err();
+    let e = coupling_forces(
+        &p,
+        &Fluid::water(),
+        view,
+        &eps.values,
+        &theta,
+        &grains,
+        &stray,
+    )
+    .unwrap_err();
     assert_eq!(e.field, "pairs");
 }

@@ -44,7 +44,10 @@ fn water_preset_rests_at_zero_pressure_with_its_sound_speed() {
 fn unknown_fluid_names_the_field_and_the_known_names() {
     let err = Fluid::by_name("oil").unwrap_err();
     assert_eq!(err.field, "fluid");
-    assert!(err.rule.contains("`oil`") && err.rule.contains("water"), "{err}");
+    assert!(
+        err.rule.contains("`oil`") && err.rule.contains("water"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -77,10 +80,7 @@ fn the_eos_reads_the_fluid_density_and_cuts_tension_at_cavitation() {
     let w = Fluid::water();
     // A particle next to a grain at ε = 0.6 with ρ̄ = ε ρ0 is at rest, not in tension.
     assert_eq!(w.pressure(600.0, 0.6, 0.0), 0.0);
-    assert_eq!(
-        w.pressure(1000.0, 0.8, 0.0),
-        w.eos.pressure(1250.0, 0.0)
-    );
+    assert_eq!(w.pressure(1000.0, 0.8, 0.0), w.eos.pressure(1250.0, 0.0));
     // Linear tension down to the cut, then the cut.
     let p = w.pressure(1000.0 * (1.0 - 1e-5), 1.0, 0.0);
     assert!((p / (-1000.0 * 1480.0f64.powi(2) * 1e-5) - 1.0).abs() < 1e-9);
@@ -128,10 +128,7 @@ fn continuity_gives_minus_rho_div_v_on_a_lattice() {
         rate += continuity_rate(rho_bar, m, rho_bar, v_ab, grad_w(&k, x_ab));
     }
     let expect = -rho_bar * (a + b);
-    assert!(
-        (rate / expect - 1.0).abs() < 0.005,
-        "{rate} vs {expect}"
-    );
+    assert!((rate / expect - 1.0).abs() < 0.005, "{rate} vs {expect}");
 }
 
 #[test]
