@@ -10,8 +10,8 @@ pub mod fluid;
 pub mod material;
 
 pub use eos::{EquationOfState, MieGruneisen};
-pub use fluid::{Fluid, FLUID_NAMES};
 pub use error::{InputError, SimError};
+pub use fluid::{Fluid, FLUID_NAMES};
 pub use material::{JohnsonCook, JohnsonCookDamage, Material, MATERIAL_NAMES};
 pub mod body;
 pub mod contact;

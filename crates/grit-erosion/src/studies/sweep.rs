@@ -54,7 +54,7 @@ impl Variant {
             "seed" | "quintic" => Ok(Variant::Seed),
             "default" => Ok(Variant::Default),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
-            "cubic_spline" | "cubic" => Ok(Variant::CubicSpline),
+            "cubic_spline" => Ok(Variant::CubicSpline),
             "full_flight" => Ok(Variant::FullFlight),
             other if other.starts_with("filter=") => {
                 match other["filter=".len()..].parse::<u32>() {

@@ -157,7 +157,7 @@ fn params_default_json_and_validation() {
 
 #[test]
 fn porosity_recovers_the_grain_area_and_is_floored() {
-    // Grains well inside a block of fluid: Σ V_a (1 − ε_a) = Σ V_i within 1 %.
+    // Grains well inside a block of fluid: Σ V_a (1 − ε_a) = Σ V_i.
     let fluid = block(60);
     let grains = vec![
         grain(1.0e-3, 1.0e-3, 0.0, 0.0),
@@ -171,7 +171,8 @@ fn porosity_recovers_the_grain_area_and_is_floored() {
     let displaced: f64 = eps.values.iter().map(|e| (1.0 - e) * DX * DX).sum();
     let solid = 3.0 * disc_area(0.5 * D);
     assert!(
-        (displaced / solid - 1.0).abs() < 0.01,
+        // The reference allows 1 %; the lattice gives 1.3e-6.
+        (displaced / solid - 1.0).abs() < 1e-5,
         "{displaced} vs {solid}"
     );
     // A lone grain at R_c = 2 d leaves ε = 1 − (10/7π) π/4 = 0.643 at its centre.
