@@ -107,6 +107,12 @@ pub fn terminal_velocity(
             format!("must lie in (0, 1], got {porosity}"),
         ));
     }
+    if !(switch.is_finite() && switch > 0.0 && switch < 1.0) {
+        return Err(InputError::new(
+            "settling.switch",
+            format!("must lie in (0, 1), got {switch}"),
+        ));
+    }
     fluid.validate("settling.fluid")?;
     let (rho_f, mu) = (fluid.density(), fluid.dynamic_viscosity_pa_s);
     let excess = (rho_p - rho_f) * g;

@@ -115,6 +115,33 @@ fn settling_reproduces_stokes_at_small_re_and_the_garnet_reference() {
 }
 
 #[test]
+fn a_released_grain_approaches_the_stokes_transient() {
+    // ρ_p dv/dt = (ρ_p − ρ_f) g − [β/(1 − ε)] v from rest, integrated at τ/2000: in the Stokes
+    // limit v = v_t (1 − e^{−t/τ}).
+    let w = Fluid::water();
+    let d = 10e-6;
+    let tau = stokes_relaxation_time(RHO_P, d, &w);
+    let vt = terminal_velocity(RHO_P, d, 1.0, &w, 9.81, 0.8)
+        .unwrap()
+        .velocity_m_s;
+    let dt = tau / 2000.0;
+    let mut v: f64 = 0.0;
+    for step in 1..=6000 {
+        let k = drag_per_volume(1.0, v.abs(), d, 1000.0, 1e-3, 0.8);
+        v += dt * ((RHO_P - 1000.0) * 9.81 - k * v) / RHO_P;
+        if step % 2000 == 0 {
+            let t = step as f64 * dt;
+            let expect = vt * (1.0 - (-t / tau).exp());
+            assert!(
+                (v / expect - 1.0).abs() < 0.01,
+                "t/τ {}: {v} vs {expect}",
+                t / tau
+            );
+        }
+    }
+}
+
+#[test]
 fn settling_rejects_bad_input_by_name() {
     let w = Fluid::water();
     let e = terminal_velocity(RHO_P, -1.0, 1.0, &w, 9.81, 0.8).unwrap_err();
@@ -123,6 +150,8 @@ fn settling_rejects_bad_input_by_name() {
     assert_eq!(e.field, "settling.porosity");
     let e = terminal_velocity(RHO_P, D, 0.0, &w, 9.81, 0.8).unwrap_err();
     assert_eq!(e.field, "settling.porosity");
+    let e = terminal_velocity(RHO_P, D, 1.0, &w, 9.81, 1.0).unwrap_err();
+    assert_eq!(e.field, "settling.switch");
 }
 
 #[test]
