@@ -103,6 +103,29 @@ impl MieGruneisen {
         self.rho0_kg_m3 * self.c0_m_s * self.c0_m_s
     }
 
+    /// Cold-curve sound speed √(dp/dρ) at e = 0 (m/s) of the shock form above: c0 at ρ0, rising
+    /// with compression; 0 beyond [`Self::singular_compression`] where the slope has no meaning.
+    pub fn sound_speed(&self, rho: f64) -> f64 {
+        let eta = rho / self.rho0_kg_m3 - 1.0;
+        if eta < 0.0 {
+            return self.c0_m_s;
+        }
+        // d/dη of k0 η N/D², N and D the numerator and denominator of the compression fraction.
+        let num = 1.0 + (1.0 - 0.5 * self.gamma0) * eta - 0.5 * self.a * eta * eta;
+        let dnum = 1.0 - 0.5 * self.gamma0 - self.a * eta;
+        let e1 = eta + 1.0;
+        let den = self.denominator(eta);
+        let dden = -(self.s1 - 1.0)
+            - self.s2 * eta * (eta + 2.0) / (e1 * e1)
+            - self.s3 * eta * eta * (eta + 3.0) / (e1 * e1 * e1);
+        if den <= 0.0 {
+            return 0.0;
+        }
+        let dp_deta = self.bulk_modulus()
+            * ((num + eta * dnum) / (den * den) - 2.0 * eta * num * dden / (den * den * den));
+        (dp_deta.max(0.0) / self.rho0_kg_m3).sqrt()
+    }
+
     /// Smallest η > 0 where the compression denominator vanishes (∞ when it never does below η = 10).
     pub fn singular_compression(&self) -> f64 {
         // The denominator starts at 1; bisect on a fine scan so S2/S3 turning points are not missed.
@@ -265,6 +288,31 @@ mod tests {
         let p = w.pressure(1100.0, e);
         assert!((p / expect - 1.0).abs() < 1e-12, "{p} vs {expect}");
         assert!(w.validate("water").is_ok());
+    }
+
+    #[test]
+    fn sound_speed_is_c0_at_rest_and_the_slope_of_the_pressure() {
+        let water = MieGruneisen {
+            rho0_kg_m3: 1000.0,
+            c0_m_s: 1480.0,
+            s1: 2.56,
+            s2: -1.986,
+            s3: 0.2268,
+            gamma0: 0.4934,
+            a: 1.3937,
+        };
+        for g in [copper(), water] {
+            assert!((g.sound_speed(g.rho0_kg_m3) - g.c0_m_s).abs() < 1e-9);
+            assert_eq!(g.sound_speed(0.9 * g.rho0_kg_m3), g.c0_m_s);
+            for eta in [0.01, 0.1, 0.3] {
+                let rho = g.rho0_kg_m3 * (1.0 + eta);
+                let d = 1e-6 * rho;
+                let fd = (g.pressure(rho + d, 0.0) - g.pressure(rho - d, 0.0)) / (2.0 * d);
+                let c = g.sound_speed(rho);
+                assert!((c * c / fd - 1.0).abs() < 1e-7, "eta {eta}: {c}² vs {fd}");
+                assert!(c > g.c0_m_s);
+            }
+        }
     }
 
     #[test]

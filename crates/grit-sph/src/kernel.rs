@@ -1,4 +1,5 @@
-//! SPH smoothing kernels (seed eq. 4 and a Wendland C2 alternative), 2D normalisation.
+//! SPH smoothing kernels (seed eq. 4, a Wendland C2 alternative and the cubic spline of the
+//! water-jet scene), 2D normalisation.
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -12,6 +13,9 @@ pub enum KernelKind {
     Quintic,
     /// Wendland C2 (Wendland 1995), support 2h; a cheaper kernel for the speed–accuracy study.
     WendlandC2,
+    /// Cubic B-spline (M4) of Monaghan & Lattanzio 1985, support 2h: the kernel of the AWJ
+    /// paper (Sci. Rep. 14, 26115, 2024; docs/jet.md#cubic-spline-kernel).
+    CubicSpline,
 }
 
 /// A kernel of fixed smoothing length h, with its normalisation precomputed.
@@ -26,11 +30,13 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// A kernel of smoothing length `h`, normalised in 2D (seed eq. 4: k = 7/(478π)).
+    /// A kernel of smoothing length `h`, normalised in 2D (seed eq. 4: k = 7/(478π); Wendland C2
+    /// 7/(4π); cubic spline 10/(7π)).
     pub fn new(kind: KernelKind, h: f64) -> Self {
         let k = match kind {
             KernelKind::Quintic => 7.0 / (478.0 * PI),
             KernelKind::WendlandC2 => 7.0 / (4.0 * PI),
+            KernelKind::CubicSpline => 10.0 / (7.0 * PI),
         };
         Kernel {
             kind,
@@ -40,11 +46,11 @@ impl Kernel {
         }
     }
 
-    /// Support radius in units of h (3 for the quintic, 2 for Wendland C2).
+    /// Support radius in units of h (3 for the quintic, 2 for Wendland C2 and the cubic spline).
     pub fn support_factor(&self) -> f64 {
         match self.kind {
             KernelKind::Quintic => 3.0,
-            KernelKind::WendlandC2 => 2.0,
+            KernelKind::WendlandC2 | KernelKind::CubicSpline => 2.0,
         }
     }
 
@@ -91,6 +97,16 @@ impl Kernel {
                 let dw = -5.0 * q * a3;
                 (self.norm * w, self.norm * self.inv_h * dw)
             }
+            KernelKind::CubicSpline => {
+                // W/norm = 1 − 3q²/2 + 3q³/4 (q < 1), (2 − q)³/4 (1 ≤ q < 2), written as
+                // [(2 − q)₊³ − 4 (1 − q)₊³]/4 with the same clamped powers as the quintic.
+                let a = (2.0 - q).max(0.0);
+                let c = (1.0 - q).max(0.0);
+                let (a2, c2) = (a * a, c * c);
+                let w = 0.25 * (a2 * a - 4.0 * c2 * c);
+                let dw = 3.0 * c2 - 0.75 * a2;
+                (self.norm * w, self.norm * self.inv_h * dw)
+            }
         }
     }
 }
@@ -98,6 +114,12 @@ impl Kernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const ALL: [KernelKind; 3] = [
+        KernelKind::Quintic,
+        KernelKind::WendlandC2,
+        KernelKind::CubicSpline,
+    ];
 
     fn integrate(k: &Kernel) -> (f64, f64) {
         // ∫ W dA = 1 and ∫ r² W dA gives the second moment; midpoint rule in r.
@@ -116,7 +138,7 @@ mod tests {
 
     #[test]
     fn kernels_are_normalised_in_2d() {
-        for kind in [KernelKind::Quintic, KernelKind::WendlandC2] {
+        for kind in ALL {
             let k = Kernel::new(kind, 1.3e-3);
             let (m0, _) = integrate(&k);
             assert!((m0 - 1.0).abs() < 1e-6, "{kind:?}: ∫W = {m0}");
@@ -125,7 +147,7 @@ mod tests {
 
     #[test]
     fn derivative_matches_finite_difference() {
-        for kind in [KernelKind::Quintic, KernelKind::WendlandC2] {
+        for kind in ALL {
             let k = Kernel::new(kind, 0.7);
             for i in 1..60 {
                 let r = i as f64 * 0.035;
@@ -137,6 +159,50 @@ mod tests {
                     "{kind:?} r={r}: {fd} vs {dw}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn cubic_spline_values_and_serde_name() {
+        let h = 2.0;
+        let k = Kernel::new(KernelKind::CubicSpline, h);
+        let norm = 10.0 / (7.0 * PI * h * h);
+        // The piecewise form term by term, and its two joints.
+        assert!((k.w(0.0) - norm).abs() < 1e-15);
+        assert!((k.w(0.5 * h) - norm * (1.0 - 1.5 * 0.25 + 0.75 * 0.125)).abs() < 1e-15);
+        assert!((k.w(h) - 0.25 * norm).abs() < 1e-15);
+        assert!((k.w(1.5 * h) - norm * 0.25 * 0.125).abs() < 1e-15);
+        assert_eq!(k.w_dw(2.0 * h), (0.0, 0.0));
+        assert_eq!(k.w_dw(3.0 * h), (0.0, 0.0));
+        assert_eq!(k.w_dw(0.0).1, 0.0);
+        // dW/dq is continuous at q = 1 (−3/4 from both sides).
+        let (_, d1) = k.w_dw(h);
+        assert!((d1 + 0.75 * norm / h).abs() < 1e-15);
+        assert_eq!(k.radius(), 2.0 * h);
+        assert_eq!(
+            serde_json::to_string(&KernelKind::CubicSpline).unwrap(),
+            "\"cubic_spline\""
+        );
+        let back: KernelKind = serde_json::from_str("\"cubic_spline\"").unwrap();
+        assert_eq!(back, KernelKind::CubicSpline);
+    }
+
+    #[test]
+    fn lattice_sums_are_near_one() {
+        // On a square lattice of spacing Δx = h/1.3 the sum Σ W Δx² is the discrete ∫W = 1:
+        // quintic and cubic spline within 1e-4, Wendland C2 1 % high.
+        for kind in ALL {
+            let dx = 1.0;
+            let k = Kernel::new(kind, 1.3 * dx);
+            let n = 6;
+            let mut s = 0.0;
+            for i in -n..=n {
+                for j in -n..=n {
+                    let r = ((i * i + j * j) as f64).sqrt() * dx;
+                    s += k.w(r) * dx * dx;
+                }
+            }
+            assert!((s - 1.0).abs() < 0.02, "{kind:?}: lattice ΣW = {s}");
         }
     }
 }

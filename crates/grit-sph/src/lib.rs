@@ -6,13 +6,16 @@
 
 pub mod eos;
 pub mod error;
+pub mod fluid;
 pub mod material;
 
 pub use eos::{EquationOfState, MieGruneisen};
 pub use error::{InputError, SimError};
+pub use fluid::{Fluid, FLUID_NAMES};
 pub use material::{JohnsonCook, JohnsonCookDamage, Material, MATERIAL_NAMES};
 pub mod body;
 pub mod contact;
+pub mod coupling;
 pub mod crater;
 pub mod dem;
 pub mod geometry;

@@ -27,6 +27,8 @@ pub enum Variant {
     Default,
     /// The Wendland C2 kernel (support 2h, about 21 neighbours against the quintic's 48).
     WendlandC2,
+    /// The cubic spline (support 2h, the kernel of the water-jet scene's paper).
+    CubicSpline,
     /// The paper's numerics at another Courant number.
     Cfl(f64),
     /// The paper's numerics with the grain's approach flight simulated step by step, as before
@@ -44,14 +46,15 @@ pub enum Variant {
 }
 
 impl Variant {
-    /// Parses `seed`, `default`, `wendland_c2`, `full_flight`, `cfl=X`, `cfl_time=X`, `filter=N` or
-    /// `absorbing=N`.
+    /// Parses `seed`, `default`, `wendland_c2`, `cubic_spline`, `full_flight`, `cfl=X`,
+    /// `cfl_time=X`, `filter=N` or `absorbing=N`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "default" => Ok(Variant::Default),
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
+            "cubic_spline" => Ok(Variant::CubicSpline),
             "full_flight" => Ok(Variant::FullFlight),
             other if other.starts_with("filter=") => {
                 match other["filter=".len()..].parse::<u32>() {
@@ -83,7 +86,7 @@ impl Variant {
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, default, wendland_c2, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N)"
+                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N)"
                 )),
             },
         }
@@ -99,6 +102,7 @@ impl Variant {
                 filter_interval_in_time(crate::impact::DEFAULT_CFL)
             ),
             Variant::WendlandC2 => "Wendland C2".into(),
+            Variant::CubicSpline => "cubic spline".into(),
             Variant::Cfl(c) => format!("CFL {c}"),
             Variant::FullFlight => "seed, flight simulated".into(),
             Variant::Absorbing(n) => format!("seed, absorbing layer of {n} Δx"),
@@ -118,6 +122,7 @@ impl Variant {
             Variant::Seed => {}
             Variant::Default => n = Numerics::default(),
             Variant::WendlandC2 => n.engine.kernel = KernelKind::WendlandC2,
+            Variant::CubicSpline => n.engine.kernel = KernelKind::CubicSpline,
             Variant::Cfl(cfl) => n.engine.cfl = cfl,
             Variant::FullFlight => n.skip_flight = false,
             Variant::Absorbing(layers) => n.absorbing_layers = layers,
@@ -523,6 +528,11 @@ mod tests {
         assert_eq!(Variant::Seed.numerics(), Numerics::seed());
         assert_eq!(Variant::Default.numerics(), Numerics::default());
         assert_eq!(Variant::parse("wendland_c2"), Ok(Variant::WendlandC2));
+        assert_eq!(Variant::parse("cubic_spline"), Ok(Variant::CubicSpline));
+        assert_eq!(
+            Variant::CubicSpline.numerics().engine.kernel,
+            KernelKind::CubicSpline
+        );
         assert_eq!(Variant::parse("cfl=0.5"), Ok(Variant::Cfl(0.5)));
         assert!(Variant::parse("cfl=3")
             .unwrap_err()

@@ -1,0 +1,251 @@
+//! The water of the abrasive water-jet scene: its preset and the per-pair terms of the fluid's
+//! SPH equations with porosity-weighted density ρ̄ = ε ρ (the AWJ paper, Sci. Rep. 14, 26115,
+//! 2024, eqs. 21–27; docs/jet.md#water).
+//!
+//! Every pair function takes ∇W = ∇_a W_ab (from [`grad_w`]), x_ab = x_a − x_b and
+//! v_ab = v_a − v_b, and returns particle a's share; particle b's is the same call with the
+//! roles swapped.
+
+use serde::{Deserialize, Serialize};
+
+use crate::eos::MieGruneisen;
+use crate::error::InputError;
+use crate::kernel::Kernel;
+use crate::math::Vector;
+
+/// Names [`Fluid::by_name`] knows, in the order error messages list them.
+pub const FLUID_NAMES: [&str; 1] = ["water"];
+
+/// Monaghan's artificial viscosity coefficients α_π, β_π (the AWJ paper eqs. 26–27).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArtificialViscosity {
+    /// Linear (bulk-viscosity) coefficient α_π (–).
+    pub alpha: f64,
+    /// Quadratic (anti-penetration) coefficient β_π (–).
+    pub beta: f64,
+}
+
+impl ArtificialViscosity {
+    /// α_π = β_π = 0.1, the AWJ paper's choice for the fluid phase (text after eq. 27).
+    pub const WATER: ArtificialViscosity = ArtificialViscosity {
+        alpha: 0.1,
+        beta: 0.1,
+    };
+
+    /// α_π = β_π = 1.0, the AWJ paper's choice for the solid phase (text after eq. 27).
+    pub const SOLID: ArtificialViscosity = ArtificialViscosity {
+        alpha: 1.0,
+        beta: 1.0,
+    };
+
+    /// Π_ab of the AWJ paper eqs. 26–27 (m⁵/(kg·s²), i.e. a pressure over a squared density):
+    /// (−α c̄ φ + β φ²)/ρ̄_ab for approaching pairs (v_ab·x_ab < 0), 0 otherwise, with
+    /// φ = h̄ v_ab·x_ab/(|x_ab|² + (0.1 h̄)²). Symmetric in a and b.
+    #[inline]
+    pub fn pi_ab(
+        &self,
+        x_ab: Vector,
+        v_ab: Vector,
+        c_mean: f64,
+        rho_mean: f64,
+        h_mean: f64,
+    ) -> f64 {
+        let vx = v_ab.dot(&x_ab);
+        if vx >= 0.0 {
+            return 0.0;
+        }
+        let phi = h_mean * vx / (x_ab.norm_squared() + 0.01 * h_mean * h_mean);
+        (-self.alpha * c_mean * phi + self.beta * phi * phi) / rho_mean
+    }
+
+    /// Checks α, β finite and ≥ 0; errors name `field.alpha` or `field.beta`.
+    pub fn validate(&self, field: &str) -> Result<(), InputError> {
+        for (name, v) in [("alpha", self.alpha), ("beta", self.beta)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(InputError::new(
+                    format!("{field}.{name}"),
+                    format!("must be a finite number >= 0, got {v}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A weakly compressible fluid: Mie–Grüneisen EOS (the AWJ paper eq. 24), dynamic viscosity for
+/// the Shao–Lo term (eq. 25) and the drag laws (eqs. 47–49), artificial viscosity (eq. 26) and the
+/// lowest pressure it sustains.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fluid {
+    /// Name used in reports.
+    pub name: String,
+    /// Pressure law; its ρ0 is the fluid's reference density.
+    pub eos: MieGruneisen,
+    /// Dynamic viscosity μ (Pa·s).
+    pub dynamic_viscosity_pa_s: f64,
+    /// Artificial viscosity coefficients of the fluid phase.
+    pub artificial_viscosity: ArtificialViscosity,
+    /// Lowest (gauge) pressure the fluid sustains (Pa, ≤ 0): the EOS's tension branch is cut here,
+    /// where the liquid would cavitate (docs/jet.md#water).
+    pub min_pressure_pa: f64,
+}
+
+/// Gauge pressure at which water at 20 °C boils under 1 atm: vapour pressure 2.34 kPa minus
+/// 101.325 kPa (docs/references.md#water).
+pub const WATER_CAVITATION_GAUGE_PA: f64 = 2.34e3 - 101.325e3;
+
+impl Fluid {
+    /// Water: ρ0 1000 kg/m³, the hydrocode Mie–Grüneisen set (c0 1480 m/s, S1 2.56, S2 −1.986,
+    /// S3 0.2268, Γ0 0.4934, a 1.3937), μ = 1e-3 Pa·s (ν = 1e-6 m²/s as in the AWJ paper),
+    /// α_π = β_π = 0.1, cut at the cavitation pressure (docs/references.md#water).
+    pub fn water() -> Self {
+        Fluid {
+            name: "water".into(),
+            eos: MieGruneisen {
+                rho0_kg_m3: 1000.0,
+                c0_m_s: 1480.0,
+                s1: 2.56,
+                s2: -1.986,
+                s3: 0.2268,
+                gamma0: 0.4934,
+                a: 1.3937,
+            },
+            dynamic_viscosity_pa_s: 1.0e-3,
+            artificial_viscosity: ArtificialViscosity::WATER,
+            min_pressure_pa: WATER_CAVITATION_GAUGE_PA,
+        }
+    }
+
+    /// The preset called `name` (one of [`FLUID_NAMES`]); an unknown name is an error on field
+    /// `fluid` that names it and lists the known ones.
+    pub fn by_name(name: &str) -> Result<Self, InputError> {
+        match name {
+            "water" => Ok(Self::water()),
+            _ => Err(InputError::new(
+                "fluid",
+                format!(
+                    "unknown fluid `{name}`; known names: {}, or a full fluid object",
+                    FLUID_NAMES.join(", ")
+                ),
+            )),
+        }
+    }
+
+    /// Checks every constant; errors name `field.<constant>` and the rule.
+    pub fn validate(&self, field: &str) -> Result<(), InputError> {
+        self.eos.validate(&format!("{field}.eos"))?;
+        InputError::require_positive(
+            format!("{field}.dynamic_viscosity_pa_s"),
+            self.dynamic_viscosity_pa_s,
+        )?;
+        self.artificial_viscosity
+            .validate(&format!("{field}.artificial_viscosity"))?;
+        if !(self.min_pressure_pa.is_finite() && self.min_pressure_pa <= 0.0) {
+            return Err(InputError::new(
+                format!("{field}.min_pressure_pa"),
+                format!(
+                    "must be a finite number <= 0 (a gauge pressure), got {}",
+                    self.min_pressure_pa
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reference density ρ0 (kg/m³), the EOS's.
+    pub fn density(&self) -> f64 {
+        self.eos.rho0_kg_m3
+    }
+
+    /// Kinematic viscosity ν = μ/ρ0 (m²/s), the ν of the Shao–Lo term (the AWJ paper eq. 25).
+    pub fn kinematic_viscosity(&self) -> f64 {
+        self.dynamic_viscosity_pa_s / self.eos.rho0_kg_m3
+    }
+
+    /// Pressure (Pa) of a fluid particle from its porosity-weighted density ρ̄ (the AWJ paper eq.
+    /// 21), porosity ε ∈ (0, 1] and specific internal energy e (J/kg; 0 without an energy
+    /// equation): the EOS (eq. 24) at the fluid's own density ρ = ρ̄/ε, floored at
+    /// `min_pressure_pa` (docs/jet.md#water, the choices).
+    #[inline]
+    pub fn pressure(&self, rho_bar: f64, porosity: f64, e: f64) -> f64 {
+        self.eos
+            .pressure(rho_bar / porosity, e)
+            .max(self.min_pressure_pa)
+    }
+
+    /// Sound speed (m/s) at the fluid's own density ρ = ρ̄/ε: √(dp/dρ) of the EOS's cold curve,
+    /// c0 at rest and in tension (for the CFL limit and c̄ of eq. 26).
+    #[inline]
+    pub fn sound_speed(&self, rho_bar: f64, porosity: f64) -> f64 {
+        self.eos.sound_speed(rho_bar / porosity)
+    }
+}
+
+/// ∇_a W_ab = (x_ab/r) dW/dr (1/m³) for x_ab = x_a − x_b; zero at r = 0 and beyond the support.
+#[inline]
+pub fn grad_w(kernel: &Kernel, x_ab: Vector) -> Vector {
+    let r = x_ab.norm();
+    if r <= 0.0 {
+        return Vector::zeros();
+    }
+    let (_, dw) = kernel.w_dw(r);
+    x_ab * (dw / r)
+}
+
+/// Particle a's continuity rate term ρ̄_a (m_b/ρ̄_b) v_ab·∇_a W_ab (kg/(m³·s) in 2D per metre of
+/// depth), the AWJ paper eq. 22 with porosity-weighted densities ρ̄ = ε ρ.
+#[inline]
+pub fn continuity_rate(
+    rho_bar_a: f64,
+    m_b: f64,
+    rho_bar_b: f64,
+    v_ab: Vector,
+    grad: Vector,
+) -> f64 {
+    rho_bar_a * (m_b / rho_bar_b) * v_ab.dot(&grad)
+}
+
+/// Particle a's pressure acceleration −m_b (P_a/ρ̄_a² + P_b/ρ̄_b²) ∇_a W_ab (m/s²), the first
+/// term of the AWJ paper eq. 23.
+#[inline]
+pub fn pressure_acceleration(
+    m_b: f64,
+    p_a: f64,
+    rho_bar_a: f64,
+    p_b: f64,
+    rho_bar_b: f64,
+    grad: Vector,
+) -> Vector {
+    -grad * (m_b * (p_a / (rho_bar_a * rho_bar_a) + p_b / (rho_bar_b * rho_bar_b)))
+}
+
+/// Particle a's laminar viscous acceleration (m/s²) in the form of Shao & Lo (2003), the AWJ
+/// paper eq. 25: 4 ν m_b (x_ab·∇_a W_ab) / [(ρ̄_a + ρ̄_b)(|x_ab|² + 0.01 h²)] v_ab; summed over
+/// the neighbours it approximates ν ∇²v.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn shao_lo_acceleration(
+    nu: f64,
+    m_b: f64,
+    rho_bar_a: f64,
+    rho_bar_b: f64,
+    x_ab: Vector,
+    v_ab: Vector,
+    grad: Vector,
+    h: f64,
+) -> Vector {
+    let r2 = x_ab.norm_squared();
+    v_ab * (4.0 * nu * m_b * x_ab.dot(&grad) / ((rho_bar_a + rho_bar_b) * (r2 + 0.01 * h * h)))
+}
+
+/// Particle a's artificial viscous acceleration −m_b Π_ab ∇_a W_ab (m/s²), the π^art term of the
+/// AWJ paper eq. 23 with Π_ab from [`ArtificialViscosity::pi_ab`].
+#[inline]
+pub fn artificial_viscosity_acceleration(m_b: f64, pi_ab: f64, grad: Vector) -> Vector {
+    -grad * (m_b * pi_ab)
+}
+
+#[cfg(test)]
+mod tests;
