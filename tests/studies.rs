@@ -233,6 +233,19 @@ fn impact_bench_prints_its_fields_with_medians_of_repeats() {
     for stage in ["kernel_sums", "forces", "stress", "contact", "neighbours"] {
         assert!(v["stages"][stage].as_f64().unwrap() > 0.0, "{stage}: {v}");
     }
+    // The bare kernel-sum loop over the same pairs, timed in the same run.
+    let c = &v["ceiling"];
+    for key in [
+        "s_per_step",
+        "pair_terms_per_step",
+        "pair_terms_per_s",
+        "particle_steps_per_s",
+        "full_step_over_ceiling",
+    ] {
+        assert!(c[key].as_f64().unwrap() > 0.0, "ceiling {key}: {v}");
+    }
+    assert!(c["steps"].as_u64().unwrap() > 0, "{v}");
+    assert!(c["full_step_over_ceiling"].as_f64().unwrap() > 1.0, "{v}");
     // The old model: every grain particle, and the flight simulated step by step.
     let full = run(&["--full-grain", "--full-flight"]);
     assert!(full["particles"].as_u64() > v["particles"].as_u64());

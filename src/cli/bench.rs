@@ -346,6 +346,18 @@ fn impact(
     if let Some(x) = b.speedup_1_to_2 {
         say!("speed-up 1 -> 2 threads   {x:.2}");
     }
+    if let Some(c) = &b.ceiling {
+        say!(
+            "ceiling (1 thread)        {:.3e} s/step, {:.3e} pair terms/s, {:.3e} particle-steps/s",
+            c.s_per_step,
+            c.pair_terms_per_s,
+            c.particle_steps_per_s
+        );
+        say!(
+            "full step / ceiling       {:.2} (1 thread)",
+            c.full_step_over_ceiling
+        );
+    }
     let total: f64 = b.stages.values().sum();
     for (k, v) in &b.stages {
         say!(

@@ -36,5 +36,5 @@ pub use kernel::{Kernel, KernelKind};
 pub use math::{Matrix, Vector};
 pub use particles::Particles;
 pub use timers::{Stage, Timers};
-pub use world::{DensityFilter, Energy, NumericalWork, Settings, World};
+pub use world::{CeilingPass, DensityFilter, Energy, NumericalWork, Settings, World};
 pub mod verification;

@@ -2,8 +2,10 @@
 //! from the same surface state, with the engine's per-stage timers.
 
 use std::collections::BTreeMap;
+use std::hint::black_box;
 use std::time::Instant;
 
+use grit_sph::World;
 use serde::{Deserialize, Serialize};
 
 use crate::sample::{Sample, SampleError};
@@ -42,6 +44,31 @@ pub struct ImpactBench {
     pub stages: BTreeMap<String, f64>,
     /// Impacts the surface had taken before the timed one.
     pub surface_impacts: u32,
+    /// The bare kernel-sum loop over the same pairs, timed in the same run.
+    #[serde(default)]
+    pub ceiling: Option<Ceiling>,
+}
+
+/// The ceiling of the pair loops: after every step of one more run of the same impact on 1
+/// thread, the bare Shepard sum Σ_j V_j W_ij (eq. 9 denominator) over the pairs that step used
+/// (`World::kernel_sum_ceiling`), timed alone. No step can run its pair loops faster than this
+/// one loop over the same pairs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ceiling {
+    /// Steps the loop ran after (every step of the impact whose pairs were still current).
+    pub steps: u64,
+    /// Seconds per step of the loop, 1 thread.
+    pub s_per_step: f64,
+    /// Pair terms per step (every used pair from each end).
+    pub pair_terms_per_step: f64,
+    /// Pair terms per second, 1 thread.
+    pub pair_terms_per_s: f64,
+    /// particles / `s_per_step`: the particle-steps per second per thread a step made of this
+    /// loop alone would reach.
+    pub particle_steps_per_s: f64,
+    /// The full step's time on 1 thread (`wall_1_thread_s` / steps) over `s_per_step`: how many
+    /// bare kernel sums the step costs.
+    pub full_step_over_ceiling: f64,
 }
 
 fn one() -> usize {
@@ -95,6 +122,17 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
     let r = many.records().last().expect("one impact ran");
     let particles = many.last_particles();
     let ps = particles as f64 * r.outcome.steps as f64;
+    let ceiling = ceiling(sample)?.map(|(steps, seconds, terms)| {
+        let s_per_step = seconds / steps as f64;
+        Ceiling {
+            steps,
+            s_per_step,
+            pair_terms_per_step: terms as f64 / steps as f64,
+            pair_terms_per_s: terms as f64 / seconds,
+            particle_steps_per_s: particles as f64 / s_per_step,
+            full_step_over_ceiling: wall1 / r.outcome.steps as f64 / s_per_step,
+        }
+    });
     Ok(ImpactBench {
         particles,
         steps: r.outcome.steps,
@@ -114,7 +152,33 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
             .map(|(k, v)| (k.to_string(), v))
             .collect(),
         surface_impacts: sample.impacts_done(),
+        ceiling,
     })
+}
+
+/// Runs the next impact of `sample` once more on 1 thread and times the bare kernel sum after
+/// every step: (steps timed, seconds, pair terms), or None when no step had current pairs.
+fn ceiling(sample: &Sample) -> Result<Option<(u64, f64, u64)>, SampleError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| SampleError::Checkpoint(format!("thread pool: {e}")))?;
+    let (mut steps, mut seconds, mut terms) = (0u64, 0.0, 0u64);
+    let mut time_it = |w: &World| {
+        let t0 = Instant::now();
+        // black_box: the sum is otherwise unused and the loop would be optimised away.
+        if let Some(c) = black_box(w.kernel_sum_ceiling()) {
+            seconds += t0.elapsed().as_secs_f64();
+            steps += 1;
+            terms += c.pair_terms;
+        }
+    };
+    let mut s = sample.clone();
+    pool.install(|| {
+        s.run_next_observed(&|| false, Some(&mut time_it))
+            .map(|_| ())
+    })?;
+    Ok((steps > 0).then_some((steps, seconds, terms)))
 }
 
 #[cfg(test)]

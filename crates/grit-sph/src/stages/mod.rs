@@ -2,6 +2,7 @@
 //! functions: each borrows what it reads, writes into the outputs it is given and returns the
 //! rest. `World::step` is the one place that runs them, in order.
 
+mod ceiling;
 mod contact;
 mod density_filter;
 mod forces;
@@ -12,6 +13,8 @@ mod rigid;
 mod stress;
 mod time_step;
 
+pub(crate) use ceiling::ceiling;
+pub use ceiling::CeilingPass;
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
 pub(crate) use forces::{forces, PairForce};

@@ -9,7 +9,7 @@ mod build;
 mod diagnostics;
 mod settings;
 
-pub use crate::stages::{HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
+pub use crate::stages::{CeilingPass, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 pub use diagnostics::{Energy, NumericalWork};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
 
@@ -284,6 +284,25 @@ impl World {
             }
         }
         Ok(())
+    }
+
+    /// The bare kernel sum Γ_i = Σ_j V_j W_ij (eq. 9 denominator) over the same-body pairs the
+    /// last step used, on the calling thread: the floor under any pair loop of the step, for a
+    /// benchmark to time beside it (docs/performance.md, "The ceiling"). None before the first
+    /// step and after particles were deleted, when those pairs are gone.
+    pub fn kernel_sum_ceiling(&self) -> Option<CeilingPass> {
+        let n = self.particles.len();
+        let sc = &self.scratch;
+        let fresh = self.nbrs_valid && sc.pairs.count.len() == n && sc.sums.vol.len() == n;
+        fresh.then(|| {
+            stages::ceiling(
+                &self.particles,
+                &self.nbrs.same,
+                &sc.pairs,
+                &sc.sums.vol,
+                &self.kernel,
+            )
+        })
     }
 
     /// Steps until `t_end` (s) or until `stop` says so; returns the number of steps.
