@@ -13,7 +13,7 @@ use crate::error::InputError;
 ///
 /// Kept an enum so a brittle model's polynomial EOS (JH-2, docs/jet.md#not-built-yet) is one
 /// more variant.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum EquationOfState {
     /// Shock Mie–Grüneisen EOS (docs/jet.md#equations-of-state).
@@ -26,6 +26,20 @@ impl EquationOfState {
     pub fn pressure(&self, rho: f64, e: f64) -> f64 {
         match self {
             EquationOfState::MieGruneisen(g) => g.pressure(rho, e),
+        }
+    }
+
+    /// Small-strain bulk modulus ρ0 c0² (Pa): the slope of p(ρ) at ρ0 and the CFL signal.
+    pub fn bulk_modulus(&self) -> f64 {
+        match self {
+            EquationOfState::MieGruneisen(g) => g.bulk_modulus(),
+        }
+    }
+
+    /// Smallest compression η > 0 where the law is singular (∞ where it never is).
+    pub fn singular_compression(&self) -> f64 {
+        match self {
+            EquationOfState::MieGruneisen(g) => g.singular_compression(),
         }
     }
 
@@ -50,7 +64,7 @@ impl EquationOfState {
 /// `p = ρ0 c0² η [1 + (1 − Γ0/2) η − (a/2) η²] / [1 − (S1 − 1) η − S2 η²/(η + 1) − S3 η³/(η + 1)²]²
 ///      + (Γ0 + a η) ρ0 e`,
 /// and in tension (η < 0) `p = ρ0 c0² η + (Γ0 + a η) ρ0 e` (docs/jet.md#equations-of-state).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MieGruneisen {
     /// Reference density ρ0 (kg/m³).

@@ -230,9 +230,18 @@ impl Material {
         self.youngs_modulus_pa / (2.0 * (1.0 + self.poisson_ratio))
     }
 
-    /// Longitudinal (P-wave) sound speed sqrt((K + 4G/3)/ρ0), the CFL signal speed.
+    /// Small-strain bulk modulus of the pressure law: K of eq. 11, or ρ0 c0² of the EOS where
+    /// the material has one (docs/jet.md#equations-of-state).
+    pub fn pressure_bulk_modulus(&self) -> f64 {
+        self.eos
+            .map_or_else(|| self.bulk_modulus(), |e| e.bulk_modulus())
+    }
+
+    /// Longitudinal (P-wave) sound speed sqrt((K + 4G/3)/ρ0) with the pressure law's K, the CFL
+    /// signal speed.
     pub fn sound_speed(&self) -> f64 {
-        ((self.bulk_modulus() + 4.0 / 3.0 * self.shear_modulus()) / self.density_kg_m3).sqrt()
+        ((self.pressure_bulk_modulus() + 4.0 / 3.0 * self.shear_modulus()) / self.density_kg_m3)
+            .sqrt()
     }
 
     /// Checks every field is physical; the error names the field and the rule.

@@ -33,6 +33,10 @@ pub struct SceneArgs {
     /// End an impact once the surface kinetic energy is below this fraction of the grain's.
     #[arg(long)]
     settle_fraction: Option<f64>,
+    /// Surface material by name: aisi304 (the seed's), copper or al6061 (Johnson–Cook with the
+    /// Mie–Grüneisen EOS, docs/jet.md).
+    #[arg(long)]
+    material: Option<String>,
     /// Full scene as JSON (an ImpactParams object); flags above override its fields.
     #[arg(long)]
     scene: Option<PathBuf>,
@@ -61,6 +65,10 @@ impl SceneArgs {
                     grit_erosion::shapes::BUILTIN_NAMES.join(", ")
                 )
             })?;
+        }
+        if let Some(name) = &self.material {
+            p.material = grit_sph::Material::by_name(name)
+                .map_err(|e| anyhow::anyhow!("{}: {}", e.field, e.rule))?;
         }
         let set = |dst: &mut f64, v: Option<f64>| {
             if let Some(v) = v {

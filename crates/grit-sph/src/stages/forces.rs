@@ -57,7 +57,7 @@ pub(crate) fn forces(
             if !c.deformable {
                 return Matrix::zeros();
             }
-            let pr = p.pressure(i, c.bulk);
+            let pr = c.pressure(p.rho[i], p.rho0[i]);
             (p.sdev[i] - Matrix::identity() * pr) / (p.rho[i] * p.rho[i] * sh[i])
         })
         .collect();

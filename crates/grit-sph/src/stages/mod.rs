@@ -28,7 +28,9 @@ pub(crate) use time_step::stable_dt;
 use rayon::iter::{IndexedParallelIterator, MaxLen, MinLen};
 
 use crate::body::Body;
+use crate::eos::EquationOfState;
 use crate::kernel::Kernel;
+use crate::material::Material;
 use crate::neighbours::NeighbourLists;
 use crate::particles::Particles;
 
@@ -83,27 +85,91 @@ pub(crate) fn volumes(p: &Particles, out: &mut Vec<f64>) {
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct BodyConst {
     pub deformable: bool,
+    /// Small-strain bulk modulus of the pressure law (the EOS's ρ0 c0² where there is one).
     pub bulk: f64,
     pub shear: f64,
     pub youngs: f64,
     pub sound: f64,
+    /// The material's EOS; `None` is the linear law of seed eq. 11.
+    pub eos: Option<EquationOfState>,
+    /// Density up to which the EOS is evaluated: 0.9 of its singular compression, so a
+    /// particle crushed beyond it gets a large finite pressure instead of a division by zero.
+    pub rho_cap: f64,
+}
+
+impl BodyConst {
+    /// Pressure of a particle of density `rho` and reference density `rho0`: K (ρ/ρ0 − 1)
+    /// (seed eq. 11), or the Mie–Grüneisen cold curve (e = 0: no energy equation is
+    /// integrated; docs/jet.md#equations-of-state gives the deficit that leaves).
+    #[inline]
+    pub fn pressure(&self, rho: f64, rho0: f64) -> f64 {
+        match &self.eos {
+            None => self.bulk * (rho / rho0 - 1.0),
+            Some(eos) => eos.pressure(rho.min(self.rho_cap), 0.0),
+        }
+    }
+}
+
+impl BodyConst {
+    /// The constants of a deformable body of material `m`.
+    pub fn of(m: &Material) -> BodyConst {
+        BodyConst {
+            deformable: true,
+            bulk: m.pressure_bulk_modulus(),
+            shear: m.shear_modulus(),
+            youngs: m.youngs_modulus_pa,
+            sound: m.sound_speed(),
+            eos: m.eos,
+            rho_cap: m.eos.map_or(f64::INFINITY, |e| {
+                e.reference_density() * (1.0 + 0.9 * e.singular_compression())
+            }),
+        }
+    }
 }
 
 /// The constants of each body, by body index (all zero and not deformable for a rigid body).
 pub(crate) fn body_consts(bodies: &[Body]) -> Vec<BodyConst> {
     bodies
         .iter()
-        .map(|b| match b.material() {
-            Some(m) => BodyConst {
-                deformable: true,
-                bulk: m.bulk_modulus(),
-                shear: m.shear_modulus(),
-                youngs: m.youngs_modulus_pa,
-                sound: m.sound_speed(),
-            },
-            None => BodyConst::default(),
-        })
+        .map(|b| b.material().map_or_else(BodyConst::default, BodyConst::of))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pressure_law_is_the_material_s() {
+        // AISI 304 has no EOS: eq. 11 with K from E and ν, the same bits as before the EOS.
+        let steel = Material::aisi304();
+        let c = BodyConst::of(&steel);
+        let (rho, rho0) = (7911.3, steel.density_kg_m3);
+        assert_eq!(c.bulk, steel.bulk_modulus());
+        assert_eq!(
+            c.pressure(rho, rho0).to_bits(),
+            (steel.bulk_modulus() * (rho / rho0 - 1.0)).to_bits()
+        );
+        // Copper: the Mie–Grüneisen cold curve, with ρ0 c0² as the bulk modulus and in the
+        // CFL's sound speed.
+        let cu = Material::copper();
+        let eos = cu.eos.unwrap();
+        let c = BodyConst::of(&cu);
+        assert_eq!(c.bulk, eos.bulk_modulus());
+        assert_eq!(c.bulk, 8960.0 * 3940.0 * 3940.0);
+        let rho = 1.05 * cu.density_kg_m3;
+        assert_eq!(c.pressure(rho, cu.density_kg_m3), eos.pressure(rho, 0.0));
+        assert!(c.pressure(rho, cu.density_kg_m3) > cu.bulk_modulus() * 0.05);
+        let g = cu.shear_modulus();
+        assert_eq!(
+            c.sound,
+            ((c.bulk + 4.0 / 3.0 * g) / cu.density_kg_m3).sqrt()
+        );
+        // Crushed past the singular compression: large, finite, and no larger than at the cap.
+        let crushed = cu.density_kg_m3 * (1.0 + 1.1 * eos.singular_compression());
+        let p = c.pressure(crushed, cu.density_kg_m3);
+        assert!(p.is_finite() && p > 0.0 && p == c.pressure(c.rho_cap, cu.density_kg_m3));
+    }
 }
 
 /// What the SPH sums over neighbours read: the particles, their neighbour lists, the kernel and

@@ -65,7 +65,7 @@ pub(crate) fn stress(
                             let wp = r.sigma_y * r.d_eps; // plastic work per volume
                             if let Some(dm) = &mat.damage {
                                 let seq = von_mises(&r.sdev);
-                                let pr = c.bulk * (*rho / rho0 - 1.0);
+                                let pr = c.pressure(*rho, rho0);
                                 let triax = if seq > 0.0 { -pr / seq } else { 0.0 };
                                 let ef = physics::fracture_strain(dm, jc, triax, *epr, *temp);
                                 *dmg += r.d_eps / ef;

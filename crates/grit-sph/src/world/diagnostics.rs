@@ -56,7 +56,7 @@ impl World {
             }
             e.kinetic += 0.5 * p.mass[i] * p.vel[i].norm_squared();
             let vol = p.mass[i] / p.rho[i];
-            let pr = p.pressure(i, bc[b].bulk);
+            let pr = bc[b].pressure(p.rho[i], p.rho0[i]);
             e.elastic += vol
                 * (pr * pr / (2.0 * bc[b].bulk) + dev_contract(&p.sdev[i]) / (4.0 * bc[b].shear));
             e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
