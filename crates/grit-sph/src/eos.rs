@@ -87,6 +87,20 @@ pub struct MieGruneisen {
 }
 
 impl MieGruneisen {
+    /// Water's hydrocode set: ρ0 1000 kg/m³, c0 1480 m/s, S1 2.56, S2 −1.986, S3 0.2268,
+    /// Γ0 0.4934, a 1.3937 (docs/references.md#water; the AWJ paper's water EOS, eq. 24).
+    pub const fn water() -> MieGruneisen {
+        MieGruneisen {
+            rho0_kg_m3: 1000.0,
+            c0_m_s: 1480.0,
+            s1: 2.56,
+            s2: -1.986,
+            s3: 0.2268,
+            gamma0: 0.4934,
+            a: 1.3937,
+        }
+    }
+
     /// Pressure (Pa) at density `rho` (kg/m³) and specific internal energy `e` (J/kg, 0 = reference).
     ///
     /// Beyond the compression where the denominator vanishes ([`Self::singular_compression`]) the
@@ -284,15 +298,7 @@ mod tests {
     #[test]
     fn water_form_with_quadratic_and_cubic_terms() {
         // Water constants of docs/jet.md; at η = 0.1 evaluate the formula term by term.
-        let w = MieGruneisen {
-            rho0_kg_m3: 1000.0,
-            c0_m_s: 1480.0,
-            s1: 2.56,
-            s2: -1.986,
-            s3: 0.2268,
-            gamma0: 0.4934,
-            a: 1.3937,
-        };
+        let w = MieGruneisen::water();
         let eta: f64 = 0.1;
         let num = 1.0 + (1.0 - 0.4934 / 2.0) * eta - 1.3937 / 2.0 * eta * eta;
         let den = 1.0 - 1.56 * eta + 1.986 * eta * eta / 1.1 - 0.2268 * eta.powi(3) / 1.21;
@@ -306,15 +312,7 @@ mod tests {
 
     #[test]
     fn sound_speed_is_c0_at_rest_and_the_slope_of_the_pressure() {
-        let water = MieGruneisen {
-            rho0_kg_m3: 1000.0,
-            c0_m_s: 1480.0,
-            s1: 2.56,
-            s2: -1.986,
-            s3: 0.2268,
-            gamma0: 0.4934,
-            a: 1.3937,
-        };
+        let water = MieGruneisen::water();
         for g in [copper(), water] {
             assert!((g.sound_speed(g.rho0_kg_m3) - g.c0_m_s).abs() < 1e-9);
             assert_eq!(g.sound_speed(0.9 * g.rho0_kg_m3), g.c0_m_s);

@@ -97,21 +97,12 @@ pub struct Fluid {
 pub const WATER_CAVITATION_GAUGE_PA: f64 = 2.34e3 - 101.325e3;
 
 impl Fluid {
-    /// Water: ρ0 1000 kg/m³, the hydrocode Mie–Grüneisen set (c0 1480 m/s, S1 2.56, S2 −1.986,
-    /// S3 0.2268, Γ0 0.4934, a 1.3937), μ = 1e-3 Pa·s (ν = 1e-6 m²/s as in the AWJ paper),
+    /// Water: the hydrocode Mie–Grüneisen set (`MieGruneisen::water`), μ = 1e-3 Pa·s (ν = 1e-6 m²/s as in the AWJ paper),
     /// α_π = β_π = 0.1, cut at the cavitation pressure (docs/references.md#water).
     pub fn water() -> Self {
         Fluid {
             name: "water".into(),
-            eos: MieGruneisen {
-                rho0_kg_m3: 1000.0,
-                c0_m_s: 1480.0,
-                s1: 2.56,
-                s2: -1.986,
-                s3: 0.2268,
-                gamma0: 0.4934,
-                a: 1.3937,
-            },
+            eos: MieGruneisen::water(),
             dynamic_viscosity_pa_s: 1.0e-3,
             artificial_viscosity: ArtificialViscosity::WATER,
             min_pressure_pa: WATER_CAVITATION_GAUGE_PA,

@@ -286,28 +286,41 @@ fn scattered() -> (
     (pos, vel, mass, rho_bar, theta, grains)
 }
 
+/// The fluid particles as the coupling reads them.
+fn fluid_view<'a>(
+    position: &'a [Vector],
+    velocity: &'a [Vector],
+    mass: &'a [f64],
+    rho_bar: &'a [f64],
+) -> FluidView<'a> {
+    FluidView {
+        position,
+        velocity,
+        mass,
+        rho_bar,
+    }
+}
+
+/// The coupling forces of water with the default parameters on `view`.
+fn water_forces(
+    view: FluidView<'_>,
+    porosity: &[f64],
+    theta: &[Vector],
+    grains: &[Grain],
+    pairs: &[Pair],
+) -> Result<CouplingForces, InputError> {
+    let p = CouplingParams::default();
+    coupling_forces(&p, &Fluid::water(), view, porosity, theta, grains, pairs)
+}
+
 #[test]
 fn action_equals_minus_reaction_to_rounding() {
     let (pos, vel, mass, rho_bar, theta, grains) = scattered();
     let p = CouplingParams::default();
     let pairs = find_pairs(&p, &pos, &grains).unwrap();
     let eps = porosity(&p, pos.len(), &grains, &pairs);
-    let view = FluidView {
-        position: &pos,
-        velocity: &vel,
-        mass: &mass,
-        rho_bar: &rho_bar,
-    };
-    let f = coupling_forces(
-        &p,
-        &Fluid::water(),
-        view,
-        &eps.values,
-        &theta,
-        &grains,
-        &pairs,
-    )
-    .unwrap();
+    let view = fluid_view(&pos, &vel, &mass, &rho_bar);
+    let f = water_forces(view, &eps.values, &theta, &grains, &pairs).unwrap();
     let on_grains: Vector = f.on_grains.iter().sum();
     let on_fluid: Vector = f.on_fluid.iter().sum();
     let scale: f64 = f.on_grains.iter().map(|v| v.norm()).sum();
@@ -347,12 +360,7 @@ fn a_grain_in_still_hydrostatic_water_feels_archimedes_only() {
         .collect();
     let vel = vec![Vector::zeros(); pos.len()];
     let mass = vec![w.density() * DX * DX; pos.len()];
-    let view = FluidView {
-        position: &pos,
-        velocity: &vel,
-        mass: &mass,
-        rho_bar: &rho_bar,
-    };
+    let view = fluid_view(&pos, &vel, &mass, &rho_bar);
     let f = coupling_forces(&p, &w, view, &eps.values, &theta, &grains, &pairs).unwrap();
     let archimedes = disc_area(0.5 * D) * w.density() * g;
     assert_eq!(f.drag[0], Vector::zeros());
@@ -373,65 +381,24 @@ fn grains_out_of_the_fluid_feel_nothing_and_bad_slices_are_named() {
     let pairs = find_pairs(&p, &pos, &grains).unwrap();
     assert!(pairs.is_empty());
     let eps = porosity(&p, pos.len(), &grains, &pairs);
-    let view = FluidView {
-        position: &pos,
-        velocity: &vel,
-        mass: &mass,
-        rho_bar: &rho_bar,
-    };
-    let f = coupling_forces(
-        &p,
-        &Fluid::water(),
-        view,
-        &eps.values,
-        &theta,
-        &grains,
-        &pairs,
-    )
-    .unwrap();
+    let view = fluid_view(&pos, &vel, &mass, &rho_bar);
+    let f = water_forces(view, &eps.values, &theta, &grains, &pairs).unwrap();
     assert_eq!(f.on_grains[0], Vector::zeros());
     assert_eq!(f.grain_fluid[0].porosity, 1.0);
     assert!(f.on_fluid.iter().all(|v| *v == Vector::zeros()));
-    let e = coupling_forces(
-        &p,
-        &Fluid::water(),
-        view,
-        &eps.values[1..],
-        &theta,
-        &grains,
-        &pairs,
-    )
-    .unwrap_err();
+    let e = water_forces(view, &eps.values[1..], &theta, &grains, &pairs).unwrap_err();
     assert_eq!(e.field, "porosity");
     let short = FluidView {
         mass: &mass[1..],
         ..view
     };
-    let e = coupling_forces(
-        &p,
-        &Fluid::water(),
-        short,
-        &eps.values,
-        &theta,
-        &grains,
-        &pairs,
-    )
-    .unwrap_err();
+    let e = water_forces(short, &eps.values, &theta, &grains, &pairs).unwrap_err();
     assert_eq!(e.field, "fluid.mass");
     let stray = [Pair {
         grain: 3,
         fluid: 0,
         w: 1.0,
     }];
-    let e = coupling_forces(
-        &p,
-        &Fluid::water(),
-        view,
-        &eps.values,
-        &theta,
-        &grains,
-        &stray,
-    )
-    .unwrap_err();
+    let e = water_forces(view, &eps.values, &theta, &grains, &stray).unwrap_err();
     assert_eq!(e.field, "pairs");
 }
