@@ -427,27 +427,17 @@ impl Dem {
             let v_rel = b.vel + omega_cross(b.omega, -n * b.radius_m)
                 - a.vel
                 - omega_cross(a.omega, n * a.radius_m);
+            let (law, ra, rb) = (self.params.pair_law(a, b), a.radius_m, b.radius_m);
             let key = ContactKey::Pair(i as u32, j as u32);
-            let mut delta_t = self.springs.get(&key).copied().unwrap_or(0.0);
-            let f = self
-                .params
-                .pair_law(a, b)
-                .force(n, overlap, v_rel, &mut delta_t, dt);
-            let fv = n * f.normal + perp(n) * f.tangential;
+            let fv = self.contact(&mut springs, key, law, n, overlap, v_rel, dt);
             self.force[i] -= fv;
             self.force[j] += fv;
-            self.torque[i] += cross(n * a.radius_m, -fv);
-            self.torque[j] += cross(-n * b.radius_m, fv);
-            springs.insert(key, delta_t);
-            self.reports.push(ContactReport {
-                key,
-                normal: n,
-                overlap,
-                force: f,
-            });
+            self.torque[i] += cross(n * ra, -fv);
+            self.torque[j] += cross(-n * rb, fv);
         }
-        for (i, g) in self.grains.iter().enumerate() {
-            for (w, wall) in self.walls.iter().enumerate() {
+        for i in 0..self.grains.len() {
+            for w in 0..self.walls.len() {
+                let (g, wall) = (&self.grains[i], &self.walls[w]);
                 let gap = (g.pos - wall.point).dot(&wall.normal);
                 let overlap = g.radius_m - gap;
                 if overlap <= 0.0 {
@@ -455,26 +445,41 @@ impl Dem {
                 }
                 let n = -wall.normal;
                 let v_rel = -(g.vel + omega_cross(g.omega, n * g.radius_m));
+                let (law, r) = (self.params.wall_law(g), g.radius_m);
                 let key = ContactKey::Wall(i as u32, w as u32);
-                let mut delta_t = self.springs.get(&key).copied().unwrap_or(0.0);
-                let f = self
-                    .params
-                    .wall_law(g)
-                    .force(n, overlap, v_rel, &mut delta_t, dt);
-                let fv = n * f.normal + perp(n) * f.tangential;
+                let fv = self.contact(&mut springs, key, law, n, overlap, v_rel, dt);
                 self.force[i] -= fv;
-                self.torque[i] += cross(n * g.radius_m, -fv);
-                springs.insert(key, delta_t);
-                self.reports.push(ContactReport {
-                    key,
-                    normal: n,
-                    overlap,
-                    force: f,
-                });
+                self.torque[i] += cross(n * r, -fv);
             }
         }
         self.springs = springs;
         self.reports.sort_by_key(|r| r.key);
+    }
+
+    /// One contact along `n` (from the first body to the second): `law` with the tangential
+    /// spring carried over from the last step, kept in `springs` for the next, and its report.
+    /// Returns the force on the second body; the first takes its opposite.
+    #[allow(clippy::too_many_arguments)]
+    fn contact(
+        &mut self,
+        springs: &mut BTreeMap<ContactKey, f64>,
+        key: ContactKey,
+        law: SpringDashpot,
+        n: Vector,
+        overlap: f64,
+        v_rel: Vector,
+        dt: f64,
+    ) -> Vector {
+        let mut delta_t = self.springs.get(&key).copied().unwrap_or(0.0);
+        let f = law.force(n, overlap, v_rel, &mut delta_t, dt);
+        springs.insert(key, delta_t);
+        self.reports.push(ContactReport {
+            key,
+            normal: n,
+            overlap,
+            force: f,
+        });
+        n * f.normal + perp(n) * f.tangential
     }
 
     /// Grain pairs whose x-extents overlap (sweep and prune on x), as (i < j) in ascending
