@@ -84,25 +84,26 @@ pub fn hugoniot() -> Result<CaseReport, SimError> {
     Ok(rep)
 }
 
-/// The AWJ paper's Fig. 4 drop: R = 5 mm from a centre height of 50 mm onto a rigid floor,
-/// garnet-like grain, e = 0.8. First contact at √(2 (h0 − R)/g), apex n at R + e^{2n} (h0 − R).
-pub fn dem_drop(dt_scale: f64) -> Result<CaseReport, SimError> {
-    let floor =
-        Wall::new(Vector::zeros(), Vector::new(0.0, 1.0)).map_err(|e| fail(e.to_string()))?;
-    let params = DemParams {
-        restitution: DROP_E,
-        ..DemParams::default()
-    };
-    let grain = Grain::sphere(Vector::new(0.0, DROP_H0), DROP_R, 4120.0);
-    let mut dem = Dem::new(vec![grain], vec![floor], params, Vector::new(0.0, -G))
-        .map_err(|e| fail(e.to_string()))?;
-    let dt = dt_scale * dem.time_step();
+/// A grain dropped in a DEM scene, followed to its third apex.
+pub(crate) struct DropRun {
+    /// Time of the first contact (s).
+    pub first_contact: Option<f64>,
+    /// Centre heights at the apexes after each bounce (m).
+    pub apexes: Vec<f64>,
+    /// Time (s) and centre height (mm), every `every` steps.
+    pub trace: (Vec<f64>, Vec<f64>),
+    /// Time of the third apex, where the run stopped (s).
+    pub end_s: f64,
+}
+
+/// Steps grain 0 of `dem` by `dt` until its third apex after a bounce (an error past 1 s or a
+/// non-finite height), noting the first contact and the apexes.
+pub(crate) fn drop_to_third_apex(dem: &mut Dem, dt: f64, every: u64) -> Result<DropRun, SimError> {
     let (mut t, mut step) = (0.0, 0u64);
     let mut first_contact = None;
     let mut apexes = Vec::new();
     let mut prev_vy = 0.0;
     let mut trace = (Vec::new(), Vec::new());
-    let every = ((2e-4 / dt).ceil() as u64).max(1);
     while apexes.len() < 3 {
         dem.step(dt, &[]).map_err(|e| fail(e.to_string()))?;
         t += dt;
@@ -127,6 +128,34 @@ pub fn dem_drop(dt_scale: f64) -> Result<CaseReport, SimError> {
             });
         }
     }
+    Ok(DropRun {
+        first_contact,
+        apexes,
+        trace,
+        end_s: t,
+    })
+}
+
+/// The AWJ paper's Fig. 4 drop: R = 5 mm from a centre height of 50 mm onto a rigid floor,
+/// garnet-like grain, e = 0.8. First contact at √(2 (h0 − R)/g), apex n at R + e^{2n} (h0 − R).
+pub fn dem_drop(dt_scale: f64) -> Result<CaseReport, SimError> {
+    let floor =
+        Wall::new(Vector::zeros(), Vector::new(0.0, 1.0)).map_err(|e| fail(e.to_string()))?;
+    let params = DemParams {
+        restitution: DROP_E,
+        ..DemParams::default()
+    };
+    let grain = Grain::sphere(Vector::new(0.0, DROP_H0), DROP_R, 4120.0);
+    let mut dem = Dem::new(vec![grain], vec![floor], params, Vector::new(0.0, -G))
+        .map_err(|e| fail(e.to_string()))?;
+    let dt = dt_scale * dem.time_step();
+    let every = ((2e-4 / dt).ceil() as u64).max(1);
+    let DropRun {
+        first_contact,
+        apexes,
+        trace,
+        end_s: t,
+    } = drop_to_third_apex(&mut dem, dt, every)?;
     let res = format!("dt = {dt:.3e} s ({dt_scale} x the DEM limit)");
     let mut rep = CaseReport::default();
     let t_ref = (2.0 * (DROP_H0 - DROP_R) / G).sqrt();
