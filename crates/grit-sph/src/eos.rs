@@ -156,6 +156,15 @@ impl MieGruneisen {
 
     /// Smallest η > 0 where the compression denominator vanishes (∞ when it never does below η = 10).
     pub fn singular_compression(&self) -> f64 {
+        // The metal form's denominator is linear in η: its root is exact and costs nothing,
+        // which matters because the engine asks for it at every step.
+        if self.s2 == 0.0 && self.s3 == 0.0 {
+            return if self.s1 > 1.0 && 1.0 / (self.s1 - 1.0) <= 10.0 {
+                1.0 / (self.s1 - 1.0)
+            } else {
+                f64::INFINITY
+            };
+        }
         // The denominator starts at 1; bisect on a fine scan so S2/S3 turning points are not missed.
         let steps = 10_000;
         let mut prev = 0.0;
@@ -332,6 +341,23 @@ mod tests {
         let g = copper();
         let eta = g.singular_compression();
         assert!((eta - 1.0 / 0.49).abs() < 1e-9, "{eta}");
+        // The scan of the general form finds the same root when S2 is all but zero.
+        let nearly = MieGruneisen { s2: 1e-300, ..g };
+        assert!((nearly.singular_compression() - eta).abs() < 1e-9);
+        // A quadratic term moves the root, which the scan finds: the denominator vanishes there.
+        let steep = MieGruneisen { s2: 0.5, ..g };
+        let eta2 = steep.singular_compression();
+        assert!(
+            eta2 < eta && steep.denominator(eta2).abs() < 1e-12,
+            "{eta2}"
+        );
+        assert!(steep.denominator(0.999 * eta2) > 0.0);
+        // Water's denominator never vanishes below η = 10, nor does a slope S1 ≤ 1.
+        assert_eq!(MieGruneisen::water().singular_compression(), f64::INFINITY);
+        assert_eq!(
+            MieGruneisen { s1: 1.0, ..g }.singular_compression(),
+            f64::INFINITY
+        );
     }
 
     #[test]
