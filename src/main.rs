@@ -44,8 +44,11 @@ enum Command {
     #[command(after_help = "Example: grit plot out/quick/results.json --out out/charts")]
     Plot(plot::Args),
     /// Print a results file's erosion normalised at 45° beside Oka's g(α), and its shape ratios
-    /// beside the seed's modified Oka, with standard errors and the project's goals.
-    #[command(after_help = "Example: grit compare docs/erosion/reduced-results.json")]
+    /// beside the seed's modified Oka, with standard errors and the project's goals; a cell that
+    /// several files have, side by side.
+    #[command(
+        after_help = "Example: grit compare docs/erosion/reduced-results.json docs/erosion/resolution24-results.json"
+    )]
     Compare(plot::CompareArgs),
     /// Run the coordinator: REST API under /api/v1 on a SQLite database.
     #[command(

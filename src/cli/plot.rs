@@ -28,23 +28,63 @@ pub struct Args {
 #[derive(ClapArgs)]
 pub struct CompareArgs {
     /// Results JSON files, merged as `grit plot` merges them (a cell an earlier file already
-    /// has is left out).
+    /// has is left out of the Oka and shape tables); a cell that several files have is also
+    /// listed per file, against the first file's (a resolution or box check).
     #[arg(required = true)]
     pub results: Vec<PathBuf>,
     /// Print the comparison as JSON instead of Markdown tables.
     #[arg(long)]
     pub json: bool,
+    /// Take every cell's erosion over the same impacts FIRST-LAST (e.g. `81-100`), as the slope
+    /// of its mean series, instead of each sample's last 20: the seed's fixed-count basis for
+    /// cells that ran to different counts.
+    #[arg(long, value_name = "FIRST-LAST", value_parser = parse_window)]
+    pub window: Option<(usize, usize)>,
 }
 
-/// Prints the results beside Oka's g(α) and the seed's shape ratios (`grit_erosion::compare`).
+/// Parses `FIRST-LAST`, two impact numbers.
+fn parse_window(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("`{s}`: expected FIRST-LAST, two impact numbers such as 81-100");
+    let (a, b) = s.split_once('-').ok_or_else(bad)?;
+    let (a, b) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    Ok((a, b))
+}
+
+/// Prints the results beside Oka's g(α) and the seed's shape ratios, and any cell that several
+/// files have side by side (`grit_erosion::compare`).
 pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
     let inputs = a
         .results
         .iter()
         .map(|p| Ok((p.display().to_string(), grit_plot::load(p)?)))
         .collect::<Result<Vec<_>, grit_plot::PlotError>>()?;
+    let inputs = match a.window {
+        None => inputs,
+        Some((first, last)) => inputs
+            .into_iter()
+            .map(|(name, mut input)| {
+                input.results = grit_erosion::compare::on_window(&input.results, first, last)
+                    .map_err(|e| anyhow!("{name}: {e}"))?;
+                Ok((name, input))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?,
+    };
+    if let Some((first, last)) = a.window {
+        if !a.json {
+            println!("Every cell's erosion is the slope of its mean series over impacts {first}-{last} (not the last 20 of each sample); standard errors of independent increments.\n");
+        }
+    }
+    let named: Vec<_> = inputs
+        .iter()
+        .map(|(n, i)| (n.clone(), &i.results))
+        .collect();
+    let repeated = grit_erosion::compare::repeated_cells(&named);
     let (input, notes) = grit_plot::merge(inputs)?;
-    let c = grit_erosion::compare::compare(&input.results);
+    let mut c = grit_erosion::compare::compare(&input.results);
+    c.repeated = repeated;
     let mut o = std::io::stdout().lock();
     if a.json {
         let _ = writeln!(o, "{}", serde_json::to_string_pretty(&c)?);

@@ -122,6 +122,152 @@ pub struct Comparison {
     pub shapes: Vec<ShapeRow>,
     /// Per shape with three or more angles: the angle of its largest mean erosion.
     pub max_angle_deg: Vec<(String, f64)>,
+    /// Cells that several of the compared files have, side by side ([`repeated_cells`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub repeated: Vec<RepeatedCell>,
+}
+
+/// One results file's erosion of a cell that several files have.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RepeatRow {
+    /// The results file, as named on the command line.
+    pub file: String,
+    /// Particle spacing Δx of its campaign (m), when its spec gives one value.
+    pub spacing_m: Option<f64>,
+    /// Grain diameter over Δx, when its spec gives both.
+    pub particles_per_dg: Option<f64>,
+    /// Samples whose slope enters the erosion.
+    pub samples: usize,
+    /// Cell erosion (mass lost / grain mass).
+    pub erosion: Option<f64>,
+    /// Standard error of `erosion`.
+    pub erosion_sem: Option<f64>,
+    /// Whether the cell passed the steady-state check (`null`: not checked).
+    pub steady: Option<bool>,
+    /// (erosion − the first file's) / √(s.e.² + the first file's s.e.²): independent samples.
+    pub z_vs_first: Option<f64>,
+}
+
+/// A cell (shape, angle and swept values) found in two or more results files: the same cell
+/// run at another resolution, on another box, or again, beside the first file's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RepeatedCell {
+    /// Grain shape.
+    pub shape: String,
+    /// Impact angle (degrees).
+    pub angle_deg: f64,
+    /// One row per file that has the cell, in the files' order.
+    pub rows: Vec<RepeatRow>,
+}
+
+/// The spec's single value of `key` (a number, or a one-element sweep).
+fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
+    let mut v = spec?;
+    for k in key {
+        v = v.get(k)?;
+    }
+    match v {
+        serde_json::Value::Array(a) if a.len() == 1 => a[0].as_f64(),
+        v => v.as_f64(),
+    }
+}
+
+/// The results with every cell's erosion taken over the same impacts `first..=last` (1-based)
+/// instead of each sample's last 20: the slope of the cell's mean series there (the mean of the
+/// samples' slopes, since every sample has the same grain masses), with the standard error of
+/// independent increments (`steady::slope_fit`). The seed compares cells at fixed impact counts
+/// (section 4); this puts cells that ran to different counts on that basis. The cells'
+/// steady-state checks are dropped, since they judge the last-20 window. Fails, naming the
+/// cell, when a cell's mean series does not cover the window with all its samples.
+pub fn on_window(
+    r: &CampaignResults,
+    first: usize,
+    last: usize,
+) -> Result<CampaignResults, String> {
+    if first < 1 || last < first + 2 {
+        return Err(format!(
+            "--window {first}-{last}: needs 1 <= first and at least 3 impacts"
+        ));
+    }
+    let mut out = r.clone();
+    for c in &mut out.cells {
+        let label = c.label();
+        let part = c
+            .mean_series
+            .get(first - 1..last)
+            .filter(|p| p.iter().all(|m| m.samples == c.samples_reported))
+            .ok_or_else(|| {
+                format!(
+                    "cell {label}: its mean series has {} impacts, not all of {first}-{last} with all {} samples",
+                    c.mean_series.len(),
+                    c.samples_reported
+                )
+            })?;
+        let x: Vec<f64> = part.iter().map(|p| p.grain_mass_kg).collect();
+        let y: Vec<f64> = part.iter().map(|p| p.mass_loss_kg).collect();
+        let fit = crate::steady::slope_fit(&x, &y);
+        c.erosion_mean = fit.map(|f| f.value);
+        c.erosion_sem = fit.map(|f| f.sem);
+        c.erosion_std = None;
+        c.erosion_sem_rel = None;
+        c.steady_state = None;
+    }
+    out.steady = None;
+    Ok(out)
+}
+
+/// Every cell that two or more of `files` have, with each file's erosion against the first's:
+/// how a cell moves with resolution, box or another run of the same campaign (seed section 4's
+/// sampling error is the yardstick).
+pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell> {
+    let mut out: Vec<RepeatedCell> = Vec::new();
+    let mut seen: Vec<(String, f64, &std::collections::BTreeMap<String, f64>)> = Vec::new();
+    for (k, (_, first)) in files.iter().enumerate() {
+        for c in &first.cells {
+            let key = (c.shape.clone(), c.angle_deg, &c.swept);
+            if seen.contains(&key) {
+                continue;
+            }
+            seen.push(key);
+            let rows: Vec<RepeatRow> = files[k..]
+                .iter()
+                .filter_map(|(name, r)| {
+                    let same = r.cells.iter().find(|d| {
+                        d.shape == c.shape && d.angle_deg == c.angle_deg && d.swept == c.swept
+                    })?;
+                    let spec = r.spec.as_ref();
+                    let spacing_m = spec_number(spec, &["spacing_m"]);
+                    let dg = spec_number(spec, &["grain", "diameter_m"]);
+                    Some(RepeatRow {
+                        file: name.clone(),
+                        spacing_m,
+                        particles_per_dg: dg.zip(spacing_m).map(|(d, s)| d / s),
+                        samples: same.samples,
+                        erosion: same.erosion_mean,
+                        erosion_sem: same.erosion_sem,
+                        steady: steady(same),
+                        z_vs_first: match (c.erosion_mean, c.erosion_sem) {
+                            (Some(a), Some(sa)) => match (same.erosion_mean, same.erosion_sem) {
+                                (Some(b), Some(sb)) if sa.hypot(sb) > 0.0 => {
+                                    Some((b - a) / sa.hypot(sb))
+                                }
+                                _ => None,
+                            },
+                            _ => None,
+                        },
+                    })
+                })
+                .collect();
+            if rows.len() >= 2 {
+                out.push(RepeatedCell {
+                    shape: c.shape.clone(),
+                    angle_deg: c.angle_deg,
+                    rows,
+                });
+            }
+        }
+    }
+    out
 }
 
 fn cell<'a>(r: &'a CampaignResults, shape: &str, angle: f64) -> Option<&'a CellResult> {
@@ -238,6 +384,7 @@ pub fn compare(r: &CampaignResults) -> Comparison {
         oka_fits,
         shapes,
         max_angle_deg,
+        repeated: Vec::new(),
     }
 }
 
@@ -418,6 +565,40 @@ pub fn markdown(c: &Comparison) -> String {
             }),
         );
     }
+    for r in &c.repeated {
+        let _ = writeln!(
+            s,
+            "\n{} at {}° in {} files (z: the difference from the first file's erosion over both standard errors):\n",
+            r.shape,
+            r.angle_deg,
+            r.rows.len()
+        );
+        table(
+            &mut s,
+            &[
+                "file",
+                "particles per Dg",
+                "samples",
+                "erosion (mg/g) ± s.e.",
+                "z against the first",
+                "cell",
+            ],
+            r.rows.iter().map(|w| {
+                vec![
+                    w.file.clone(),
+                    num(w.particles_per_dg, 1),
+                    w.samples.to_string(),
+                    format!(
+                        "{} ± {}",
+                        num(w.erosion.map(|e| 1e3 * e), 2),
+                        num(w.erosion_sem.map(|e| 1e3 * e), 2)
+                    ),
+                    num(w.z_vs_first, 1),
+                    yes_no(w.steady, "steady", "**unsteady**"),
+                ]
+            }),
+        );
+    }
     s
 }
 
@@ -555,5 +736,80 @@ mod tests {
     fn a_cell_without_its_reference_is_left_out() {
         let c = compare(&results(vec![cell("square", 90.0, 1e-3, 1e-4, true)]));
         assert!(c.angles.is_empty() && c.shapes.is_empty());
+    }
+
+    #[test]
+    fn a_cell_in_several_files_is_set_beside_the_first_with_its_resolution() {
+        let spec =
+            |dx: f64| serde_json::json!({"spacing_m": [dx], "grain": {"diameter_m": 250e-6}});
+        let coarse = results(vec![
+            cell("hexagon", 45.0, 3e-3, 0.3e-3, true),
+            cell("hexagon", 90.0, 2e-3, 0.2e-3, true),
+        ])
+        .with_spec(spec(250e-6 / 16.0));
+        let fine = results(vec![
+            cell("hexagon", 45.0, 3.5e-3, 0.4e-3, false),
+            cell("hexagon", 15.0, 1e-3, 0.1e-3, true),
+        ])
+        .with_spec(spec(250e-6 / 24.0));
+        let files = [
+            ("a.json".to_string(), &coarse),
+            ("b.json".to_string(), &fine),
+        ];
+        let rep = repeated_cells(&files);
+        // Only 45° is in both files; 90° and 15° are in one each.
+        assert_eq!(rep.len(), 1);
+        let r = &rep[0];
+        assert_eq!((r.shape.as_str(), r.angle_deg), ("hexagon", 45.0));
+        assert_eq!(r.rows.len(), 2);
+        assert!((r.rows[0].particles_per_dg.unwrap() - 16.0).abs() < 1e-9);
+        assert!((r.rows[1].particles_per_dg.unwrap() - 24.0).abs() < 1e-9);
+        assert_eq!(r.rows[0].z_vs_first, Some(0.0));
+        // 0.5e-3 apart over √(0.3² + 0.4²) = 0.5e-3: one combined standard error.
+        assert!((r.rows[1].z_vs_first.unwrap() - 1.0).abs() < 1e-9);
+        assert_eq!(r.rows[1].steady, Some(false));
+        let mut c = compare(&coarse);
+        c.repeated = rep;
+        let md = markdown(&c);
+        assert!(
+            md.contains("| b.json | 24.0 | 10 | 3.50 ± 0.40 | 1.0 | **unsteady** |"),
+            "{md}"
+        );
+    }
+
+    #[test]
+    fn a_common_window_takes_the_mean_series_slope_there() {
+        let mut a = cell("hexagon", 45.0, 9.0, 9.0, true);
+        let mut b = cell("square", 45.0, 9.0, 9.0, true);
+        // Hexagon: nothing until impact 10, then 2 per impact; square: 3 per impact throughout.
+        let series = |loss: &dyn Fn(f64) -> f64, n: usize| {
+            (1..=n)
+                .map(|k| crate::aggregate::MeanPoint {
+                    impact: k,
+                    grain_mass_kg: k as f64,
+                    mass_loss_kg: loss(k as f64),
+                    mass_loss_std_kg: None,
+                    samples: 10,
+                })
+                .collect::<Vec<_>>()
+        };
+        a.mean_series = series(&|k| 2.0 * (k - 10.0).max(0.0), 40);
+        b.mean_series = series(&|k| 3.0 * k, 30);
+        let r = on_window(&results(vec![a, b]), 11, 30).unwrap();
+        assert_eq!(r.cells[0].erosion_mean, Some(2.0));
+        assert_eq!(r.cells[1].erosion_mean, Some(3.0));
+        assert_eq!(r.cells[0].erosion_sem, Some(0.0));
+        assert!(r.cells.iter().all(|c| c.steady_state.is_none()));
+        let e = on_window(&results(vec![cell("square", 45.0, 1.0, 0.1, true)]), 11, 30);
+        assert!(
+            e.unwrap_err().starts_with("cell 45° square"),
+            "names the cell"
+        );
+        let short = on_window(&r, 31, 40).unwrap_err();
+        assert!(
+            short.contains("square") && short.contains("30 impacts"),
+            "{short}"
+        );
+        assert!(on_window(&r, 5, 6).is_err());
     }
 }
