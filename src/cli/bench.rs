@@ -123,7 +123,8 @@ pub struct SweepArgs {
     /// 2022: CFL 0.3, the density filter every 40 steps), default (grit's default scene),
     /// wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X (CFL X with the density filter's
     /// seed period in simulated time), filter=N (the density filter every N steps, 0 = off),
-    /// absorbing=N; the first is the reference.
+    /// absorbing=N, h=X (the default numerics with h/Δx = X, in [1, 2]); the first is the
+    /// reference.
     #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
     variants: Vec<String>,
     /// Resolutions of the variants after the first (default: all of --ppd).

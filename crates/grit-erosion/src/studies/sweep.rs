@@ -43,11 +43,14 @@ pub enum Variant {
     /// The paper's numerics at another Courant number, with the filter interval in steps scaled
     /// so that the filter runs as often in simulated time as the seed's 40 steps at CFL 0.3.
     CflFilterInTime(f64),
+    /// The default scene's numerics with another smoothing length over spacing h/Δx (seed eq. 4
+    /// with the seed's 1.3): fewer neighbours per particle, but a shorter step (dt ∝ h).
+    HOverDx(f64),
 }
 
 impl Variant {
     /// Parses `seed`, `default`, `wendland_c2`, `cubic_spline`, `full_flight`, `cfl=X`,
-    /// `cfl_time=X`, `filter=N` or `absorbing=N`.
+    /// `cfl_time=X`, `filter=N`, `absorbing=N` or `h=X`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
@@ -72,6 +75,12 @@ impl Variant {
                     _ => bad(format!("`{other}`: the Courant number must be in (0, 2]")),
                 }
             }
+            other if other.starts_with("h=") => match other["h=".len()..].parse::<f64>() {
+                // Below 1 the quintic's support (3h) holds too few neighbours for the
+                // correction matrices (eq. 8) near a free surface.
+                Ok(h) if (1.0..=2.0).contains(&h) => Ok(Variant::HOverDx(h)),
+                _ => bad(format!("`{other}`: h/Δx must be in [1, 2]")),
+            },
             other if other.starts_with("absorbing=") => {
                 match other["absorbing=".len()..].parse::<f64>() {
                     Ok(n) if n.is_finite() && n > 0.0 => Ok(Variant::Absorbing(n)),
@@ -86,7 +95,7 @@ impl Variant {
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N)"
+                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N, h=X)"
                 )),
             },
         }
@@ -112,6 +121,7 @@ impl Variant {
                 "CFL {c}, density filter every {} steps",
                 filter_interval_in_time(*c)
             ),
+            Variant::HOverDx(h) => format!("default, h/Δx = {h}"),
         }
     }
 
@@ -128,6 +138,10 @@ impl Variant {
             Variant::Absorbing(layers) => n.absorbing_layers = layers,
             Variant::Filter(every) => n.engine.shepard_interval = every,
             Variant::CflFilterInTime(cfl) => n = n.with_cfl_filter_in_time(cfl),
+            Variant::HOverDx(h) => {
+                n = Numerics::default();
+                n.engine.h_over_dx = h;
+            }
         }
         n
     }
@@ -540,6 +554,13 @@ mod tests {
             .contains("(0, 2]"));
         assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
         assert_eq!(Variant::parse("filter=0"), Ok(Variant::Filter(0)));
+        assert_eq!(Variant::parse("h=1.1"), Ok(Variant::HOverDx(1.1)));
+        assert_eq!(Variant::HOverDx(1.1).numerics().engine.h_over_dx, 1.1);
+        assert_eq!(Variant::HOverDx(1.3).numerics(), Numerics::default());
+        assert!(Variant::parse("h=0.8")
+            .unwrap_err()
+            .to_string()
+            .contains("[1, 2]"));
         assert!(Variant::parse("filter=-1").is_err());
         assert_eq!(
             Variant::parse("cfl_time=0.6"),
