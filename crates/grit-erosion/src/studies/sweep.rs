@@ -265,6 +265,7 @@ pub fn run_resolution(
         Settings {
             kernel: n.engine.kernel,
             cfl: n.engine.cfl,
+            h_over_dx: n.engine.h_over_dx,
             shepard_interval: hertz::DENSITY_FILTER,
             ..Settings::default()
         },
