@@ -123,6 +123,7 @@ pub struct SweepArgs {
     /// 2022: CFL 0.3, the density filter every 40 steps), default (grit's default scene),
     /// wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X (CFL X with the density filter's
     /// seed period in simulated time), filter=N (the density filter every N steps, 0 = off),
+    /// default_filter=N (the default numerics with the filter every N steps, 0 = off),
     /// absorbing=N, h=X (the default numerics with h/Δx = X, in [1, 2]); the first is the
     /// reference.
     #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]

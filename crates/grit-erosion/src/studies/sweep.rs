@@ -43,6 +43,9 @@ pub enum Variant {
     /// The paper's numerics at another Courant number, with the filter interval in steps scaled
     /// so that the filter runs as often in simulated time as the seed's 40 steps at CFL 0.3.
     CflFilterInTime(f64),
+    /// The default scene's numerics with the density filter (eq. 12) every this many steps
+    /// instead of its period in time; 0 switches it off.
+    DefaultFilter(u32),
     /// The default scene's numerics with another smoothing length over spacing h/Δx (seed eq. 4
     /// with the seed's 1.3): fewer neighbours per particle, but a shorter step (dt ∝ h).
     HOverDx(f64),
@@ -50,7 +53,7 @@ pub enum Variant {
 
 impl Variant {
     /// Parses `seed`, `default`, `wendland_c2`, `cubic_spline`, `full_flight`, `cfl=X`,
-    /// `cfl_time=X`, `filter=N`, `absorbing=N` or `h=X`.
+    /// `cfl_time=X`, `filter=N`, `default_filter=N`, `absorbing=N` or `h=X`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         let bad = |rule: String| Err(InputError::new("--variants", rule));
         match s.trim() {
@@ -59,6 +62,14 @@ impl Variant {
             "wendland_c2" | "wendland" => Ok(Variant::WendlandC2),
             "cubic_spline" => Ok(Variant::CubicSpline),
             "full_flight" => Ok(Variant::FullFlight),
+            other if other.starts_with("default_filter=") => {
+                match other["default_filter=".len()..].parse::<u32>() {
+                    Ok(n) => Ok(Variant::DefaultFilter(n)),
+                    _ => bad(format!(
+                        "`{other}`: the filter interval is a whole number of steps (0 = off)"
+                    )),
+                }
+            }
             other if other.starts_with("filter=") => {
                 match other["filter=".len()..].parse::<u32>() {
                     Ok(n) => Ok(Variant::Filter(n)),
@@ -95,7 +106,7 @@ impl Variant {
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, absorbing=N, h=X)"
+                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, default_filter=N, absorbing=N, h=X)"
                 )),
             },
         }
@@ -122,6 +133,8 @@ impl Variant {
                 filter_interval_in_time(*c)
             ),
             Variant::HOverDx(h) => format!("default, h/Δx = {h}"),
+            Variant::DefaultFilter(0) => "default, no density filter".into(),
+            Variant::DefaultFilter(n) => format!("default, density filter every {n} steps"),
         }
     }
 
@@ -138,6 +151,10 @@ impl Variant {
             Variant::Absorbing(layers) => n.absorbing_layers = layers,
             Variant::Filter(every) => n.engine.shepard_interval = every,
             Variant::CflFilterInTime(cfl) => n = n.with_cfl_filter_in_time(cfl),
+            Variant::DefaultFilter(every) => {
+                n = Numerics::default();
+                n.engine.shepard_interval = every;
+            }
             Variant::HOverDx(h) => {
                 n = Numerics::default();
                 n.engine.h_over_dx = h;
@@ -556,6 +573,9 @@ mod tests {
         assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
         assert_eq!(Variant::parse("filter=0"), Ok(Variant::Filter(0)));
         assert_eq!(Variant::parse("h=1.1"), Ok(Variant::HOverDx(1.1)));
+        let off = Variant::parse("default_filter=0").unwrap().numerics();
+        assert_eq!(off.engine.shepard_interval, 0);
+        assert_eq!(off.engine.cfl, Numerics::default().engine.cfl);
         assert_eq!(Variant::HOverDx(1.1).numerics().engine.h_over_dx, 1.1);
         assert_eq!(Variant::HOverDx(1.3).numerics(), Numerics::default());
         assert!(Variant::parse("h=0.8")
