@@ -61,13 +61,16 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|p| Ok((p.display().to_string(), grit_plot::load(p)?)))
         .collect::<Result<Vec<_>, grit_plot::PlotError>>()?;
+    let mut window_notes = Vec::new();
     let inputs = match a.window {
         None => inputs,
         Some((first, last)) => inputs
             .into_iter()
             .map(|(name, mut input)| {
-                input.results = grit_erosion::compare::on_window(&input.results, first, last)
+                let (r, notes) = grit_erosion::compare::on_window(&input.results, first, last)
                     .map_err(|e| anyhow!("{name}: {e}"))?;
+                input.results = r;
+                window_notes.extend(notes.into_iter().map(|n| format!("{name}: {n}")));
                 Ok((name, input))
             })
             .collect::<anyhow::Result<Vec<_>>>()?,
@@ -90,7 +93,7 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
         let _ = writeln!(o, "{}", serde_json::to_string_pretty(&c)?);
     } else {
         let _ = write!(o, "{}", grit_erosion::compare::markdown(&c));
-        for n in notes {
+        for n in window_notes.into_iter().chain(notes) {
             let _ = writeln!(o, "note: {n}");
         }
     }

@@ -177,32 +177,37 @@ fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
 /// samples' slopes, since every sample has the same grain masses), with the standard error of
 /// independent increments (`steady::slope_fit`). The seed compares cells at fixed impact counts
 /// (section 4); this puts cells that ran to different counts on that basis. The cells'
-/// steady-state checks are dropped, since they judge the last-20 window. Fails, naming the
-/// cell, when a cell's mean series does not cover the window with all its samples.
+/// steady-state checks are dropped, since they judge the last-20 window. A cell whose mean
+/// series does not cover the window with all its samples is left out, with a note naming it.
 pub fn on_window(
     r: &CampaignResults,
     first: usize,
     last: usize,
-) -> Result<CampaignResults, String> {
+) -> Result<(CampaignResults, Vec<String>), String> {
     if first < 1 || last < first + 2 {
         return Err(format!(
             "--window {first}-{last}: needs 1 <= first and at least 3 impacts"
         ));
     }
     let mut out = r.clone();
-    for c in &mut out.cells {
-        let label = c.label();
-        let part = c
+    let mut notes = Vec::new();
+    out.cells.retain(|c| {
+        let covered = c
             .mean_series
             .get(first - 1..last)
-            .filter(|p| p.iter().all(|m| m.samples == c.samples_reported))
-            .ok_or_else(|| {
-                format!(
-                    "cell {label}: its mean series has {} impacts, not all of {first}-{last} with all {} samples",
-                    c.mean_series.len(),
-                    c.samples_reported
-                )
-            })?;
+            .is_some_and(|p| p.iter().all(|m| m.samples == c.samples_reported));
+        if !covered {
+            notes.push(format!(
+                "cell {} left out: its mean series has {} impacts, not all of {first}-{last} with all {} samples",
+                c.label(),
+                c.mean_series.len(),
+                c.samples_reported
+            ));
+        }
+        covered
+    });
+    for c in &mut out.cells {
+        let part = &c.mean_series[first - 1..last];
         let x: Vec<f64> = part.iter().map(|p| p.grain_mass_kg).collect();
         let y: Vec<f64> = part.iter().map(|p| p.mass_loss_kg).collect();
         let fit = crate::steady::slope_fit(&x, &y);
@@ -213,7 +218,7 @@ pub fn on_window(
         c.steady_state = None;
     }
     out.steady = None;
-    Ok(out)
+    Ok((out, notes))
 }
 
 /// Every cell that two or more of `files` have, with each file's erosion against the first's:
@@ -795,20 +800,18 @@ mod tests {
         };
         a.mean_series = series(&|k| 2.0 * (k - 10.0).max(0.0), 40);
         b.mean_series = series(&|k| 3.0 * k, 30);
-        let r = on_window(&results(vec![a, b]), 11, 30).unwrap();
+        let (r, notes) = on_window(&results(vec![a, b]), 11, 30).unwrap();
+        assert!(notes.is_empty());
         assert_eq!(r.cells[0].erosion_mean, Some(2.0));
         assert_eq!(r.cells[1].erosion_mean, Some(3.0));
         assert_eq!(r.cells[0].erosion_sem, Some(0.0));
         assert!(r.cells.iter().all(|c| c.steady_state.is_none()));
-        let e = on_window(&results(vec![cell("square", 45.0, 1.0, 0.1, true)]), 11, 30);
+        // The square stops at 30 impacts: left out of 31-40, with a note naming it.
+        let (short, notes) = on_window(&r, 31, 40).unwrap();
+        assert_eq!(short.cells.len(), 1);
+        assert_eq!(short.cells[0].shape, "hexagon");
         assert!(
-            e.unwrap_err().starts_with("cell 45° square"),
-            "names the cell"
-        );
-        let short = on_window(&r, 31, 40).unwrap_err();
-        assert!(
-            short.contains("square") && short.contains("30 impacts"),
-            "{short}"
+            notes[0].starts_with("cell 45° square left out") && notes[0].contains("30 impacts")
         );
         assert!(on_window(&r, 5, 6).is_err());
     }
