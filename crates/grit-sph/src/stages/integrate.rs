@@ -1,4 +1,4 @@
-//! Integration of the deformable particles (semi-implicit Euler) and the checks that end a step
+//! Integration of the deformable and fluid particles (semi-implicit Euler) and the checks that end a step
 //! which has blown up.
 
 use rayon::prelude::*;
@@ -25,7 +25,7 @@ struct Update {
     absorbed: f64,
 }
 
-/// Integrates deformable particles from `time` by `dt` (semi-implicit Euler) with the SPH
+/// Integrates deformable and fluid particles from `time` by `dt` (semi-implicit Euler) with the SPH
 /// accelerations `acc` and the contact forces `contact_force`, damped in absorbing layers; adds
 /// the layers' work to `absorbed`, in particle order. Then the failure checks: finite state,
 /// positive density, no particle moved more than `h`, finite rigid bodies.
@@ -47,6 +47,9 @@ pub(crate) fn integrate(
         .map(|b| match &b.kind {
             BodyKind::Deformable {
                 boundary_motion, ..
+            }
+            | BodyKind::Fluid {
+                boundary_motion, ..
             } => boundary_motion.velocity(t_next),
             _ => None,
         })
@@ -67,7 +70,7 @@ pub(crate) fn integrate(
         .enumerate()
         .map(|(i, (x, v))| {
             let b = p.body[i] as usize;
-            if !bc[b].deformable {
+            if !bc[b].integrated() {
                 return Update {
                     failure: None,
                     absorbed: 0.0,

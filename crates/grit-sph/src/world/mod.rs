@@ -43,6 +43,8 @@ struct Scratch {
     acc: Vec<Vector>,
     /// Contact force on each particle.
     contact_force: Vec<Vector>,
+    /// Continuity rates dρ̄/dt of the fluid particles (the fluid stage fills it).
+    drho: Vec<f64>,
 }
 
 /// A 2D SPH scene: bodies, their particles, contact pairs, time.
@@ -395,6 +397,17 @@ impl World {
             dt,
         );
         self.work.plastic -= plastic_work;
+        if bc.iter().any(|c| c.fluid.is_some()) {
+            let s = SphView {
+                p: &self.particles,
+                nl: &self.nbrs.same,
+                k: &self.kernel,
+                bc,
+            };
+            let sc = &mut self.scratch;
+            stages::fluid_continuity(s, &self.nbrs.half, &sc.pairs, &mut sc.drho);
+            stages::fluid_density(&mut self.particles, bc, &sc.drho, dt);
+        }
     }
 
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
@@ -419,6 +432,10 @@ impl World {
             &mut sc.pair_forces,
         );
         self.work.hourglass += hg;
+        if bc.iter().any(|c| c.fluid.is_some()) {
+            let g = self.settings.gravity_m_s2;
+            stages::fluid_accelerations(s, &self.nbrs.half, &sc.pairs, g, &mut sc.acc);
+        }
     }
 
     fn contact(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
