@@ -47,8 +47,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         &[25, 35, 50]
     };
-    // The water-jet blocks' DEM rows, at the DEM step limit or half of it.
-    let jet_dt = if a.quick { 1.0 } else { 0.5 };
+    // The water-jet blocks' DEM rows, at the DEM step limit or half of it, and the water
+    // column's particles per height.
+    let (jet_dt, jet_n) = if a.quick { (1.0, 20) } else { (0.5, 40) };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [
@@ -57,7 +58,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         ("hertz", Box::new(move || hertz::run(hertz_n))),
         ("impact", Box::new(move || elastic_impact::run(impact_n))),
         ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
-        ("jet", Box::new(move || jet::run(jet_dt))),
+        ("jet", Box::new(move || jet::run(jet_dt, jet_n))),
     ];
     for (name, f) in cases.iter() {
         if !want(name) {

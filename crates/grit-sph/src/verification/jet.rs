@@ -1,6 +1,6 @@
 //! Checks of the water-jet scene's building blocks with analytic references (docs/jet.md):
-//! the copper Hugoniot of the Mie–Grüneisen EOS, the DEM drop of the AWJ paper's Fig. 4 and the
-//! head-on restitution of two grains.
+//! the copper Hugoniot of the Mie–Grüneisen EOS, the DEM drop of the AWJ paper's Fig. 4, the
+//! head-on restitution of two grains, and the water column at rest (`super::hydrostatic`).
 
 use super::{CaseReport, Chart, Row, Series};
 use crate::dem::{contact_time, damping_ratio, Dem, DemParams, Grain, Wall};
@@ -35,13 +35,15 @@ fn fail(what: String) -> SimError {
     }
 }
 
-/// Runs all rows; the DEM steps are `dt_scale` × `Dem::time_step()`.
-pub fn run(dt_scale: f64) -> Result<CaseReport, SimError> {
+/// Runs all rows; the DEM steps are `dt_scale` × `Dem::time_step()`, the water column is
+/// `hydro_n` particles high.
+pub fn run(dt_scale: f64, hydro_n: usize) -> Result<CaseReport, SimError> {
     let mut rep = hugoniot()?;
     rep.extend(dem_drop(dt_scale)?);
     for e in [0.3, 0.8, 0.95] {
         rep.extend(restitution(e, dt_scale)?);
     }
+    rep.extend(super::hydrostatic::hydrostatic(hydro_n)?);
     Ok(rep)
 }
 
@@ -319,8 +321,8 @@ mod tests {
 
     #[test]
     fn every_row_meets_its_tolerance() {
-        let rep = run(1.0).unwrap();
-        assert_eq!(rep.rows.len(), 2 + 4 + 6);
+        let rep = run(1.0, 12).unwrap();
+        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2);
         for r in &rep.rows {
             assert!(
                 r.pass != r.expected_fail,
@@ -331,7 +333,7 @@ mod tests {
             );
             assert!(r.case.starts_with("jet_"));
         }
-        assert_eq!(rep.charts.len(), 1);
+        assert_eq!(rep.charts.len(), 2);
     }
 
     #[test]

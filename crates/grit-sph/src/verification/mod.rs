@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 pub mod elastic_impact;
 pub mod hertz;
 pub mod hourglass;
+pub mod hydrostatic;
 pub mod jet;
 pub mod sliding;
 pub mod slope;
