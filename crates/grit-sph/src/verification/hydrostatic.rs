@@ -164,7 +164,9 @@ pub fn hydrostatic(n: usize) -> Result<CaseReport, SimError> {
         note: format!(
             "mean pressure (Pa) of the bottom fluid row against rho0 g (H - y) at its mean height \
              {y_bottom:.4e} m, averaged over {WINDOW_TIMES} sqrt(H/g) after {SETTLE_TIMES} \
-             sqrt(H/g); bound 2%"
+             sqrt(H/g) ({} steps, {} particles); bound 2%",
+            world.steps(),
+            world.particles().len()
         ),
     });
     rep.rows.push(Row {
