@@ -1,5 +1,5 @@
-//! Integration of the deformable and fluid particles (semi-implicit Euler) and the checks that end a step
-//! which has blown up.
+//! Integration of the deformable and fluid particles (semi-implicit Euler) and the checks that
+//! end a step which has blown up.
 
 use rayon::prelude::*;
 
@@ -25,9 +25,9 @@ struct Update {
     absorbed: f64,
 }
 
-/// Integrates deformable and fluid particles from `time` by `dt` (semi-implicit Euler) with the SPH
-/// accelerations `acc` and the contact forces `contact_force`, damped in absorbing layers; adds
-/// the layers' work to `absorbed`, in particle order. Then the failure checks: finite state,
+/// Integrates deformable and fluid particles from `time` by `dt` (semi-implicit Euler) with the
+/// SPH accelerations `acc` and the contact forces `contact_force`, damped in absorbing layers;
+/// adds the layers' work to `absorbed`, in particle order. Then the failure checks: finite state,
 /// positive density, no particle moved more than `h`, finite rigid bodies.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate(

@@ -81,6 +81,7 @@ impl World {
         }
         let b = self.bodies.len();
         let rho = material.density_kg_m3;
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Deformable {
@@ -156,6 +157,7 @@ impl World {
             .collect::<Result<Vec<f64>, InputError>>()?;
         let rho0 = fluid.density();
         let b = self.bodies.len();
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Fluid {
@@ -250,6 +252,7 @@ impl World {
             ));
         }
         let b = self.bodies.len();
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Deformable {
@@ -380,6 +383,7 @@ impl World {
         let inertia = density_kg_m3 * polygon.polar_moment();
         let com = polygon.centroid();
         let b = self.bodies.len();
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Rigid(Rigid {

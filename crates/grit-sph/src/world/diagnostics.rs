@@ -46,7 +46,7 @@ pub struct NumericalWork {
 impl World {
     /// Kinetic, elastic, contact-spring and gravity energy (J/m).
     pub fn energy(&self) -> Energy {
-        let bc = crate::stages::body_consts(&self.bodies);
+        let bc = self.body_consts();
         let p = &self.particles;
         let mut e = Energy::default();
         for i in 0..p.len() {
