@@ -1,8 +1,10 @@
-//! Bodies: deformable Johnson–Cook solids and rigid bodies (grains, walls, sliders) whose
-//! motion follows total force and torque (seed eq. 17).
+//! Bodies: deformable Johnson–Cook solids, rigid bodies (grains, walls, sliders) whose
+//! motion follows total force and torque (seed eq. 17), and weakly compressible fluids (the AWJ
+//! paper's water, docs/jet.md#water-in-the-engine).
 
 use serde::{Deserialize, Serialize};
 
+use crate::fluid::Fluid;
 use crate::material::Material;
 use crate::math::Vector;
 
@@ -150,6 +152,14 @@ pub enum BodyKind {
     },
     /// A rigid body.
     Rigid(Rigid),
+    /// A weakly compressible fluid (the AWJ paper eqs. 21–27): its particles carry the
+    /// porosity-weighted density ρ̄; its kinematic particles are the walls that hold it.
+    Fluid {
+        /// Its EOS, viscosity and artificial viscosity.
+        fluid: Fluid,
+        /// Motion of its kinematic (wall) particles.
+        boundary_motion: Motion,
+    },
 }
 
 /// A body of the scene.
@@ -186,6 +196,14 @@ impl Body {
     pub fn material(&self) -> Option<&Material> {
         match &self.kind {
             BodyKind::Deformable { material, .. } => Some(material),
+            _ => None,
+        }
+    }
+
+    /// The fluid, if a fluid body.
+    pub fn fluid(&self) -> Option<&Fluid> {
+        match &self.kind {
+            BodyKind::Fluid { fluid, .. } => Some(fluid),
             _ => None,
         }
     }

@@ -166,6 +166,58 @@ impl Fluid {
             .max(self.min_pressure_pa)
     }
 
+    /// The density ρ (kg/m³) at which the EOS's cold curve (eq. 24, e = 0) gives the gauge
+    /// pressure `pressure_pa`: the inverse of [`Self::pressure`] at ε = 1, for setting up a
+    /// fluid at rest under a known pressure (a hydrostatic column). An error on `field` for a
+    /// pressure that is not finite, below `min_pressure_pa`, or beyond what the law reaches short
+    /// of its singular compression.
+    pub fn density_at(&self, pressure_pa: f64, field: &str) -> Result<f64, InputError> {
+        if !(pressure_pa.is_finite() && pressure_pa >= self.min_pressure_pa) {
+            return Err(InputError::new(
+                field,
+                format!(
+                    "must be a finite pressure >= min_pressure_pa ({} Pa), got {pressure_pa}",
+                    self.min_pressure_pa
+                ),
+            ));
+        }
+        let g = &self.eos;
+        let rho0 = g.rho0_kg_m3;
+        if pressure_pa <= 0.0 {
+            // The tension branch is linear.
+            return Ok(rho0 * (1.0 + pressure_pa / g.bulk_modulus()));
+        }
+        // The compression branch rises from 0 until its numerator's η² term or the singular
+        // compression turns it over: the bracket doubles while the pressure still rises, within
+        // the 0.9 of the singular compression the engine evaluates.
+        let p_at = |eta: f64| g.pressure(rho0 * (1.0 + eta), 0.0);
+        let cap = 0.9 * g.singular_compression().min(10.0);
+        let mut eta_max = 1e-3_f64.min(cap);
+        while 2.0 * eta_max <= cap && p_at(2.0 * eta_max) > p_at(eta_max) {
+            eta_max *= 2.0;
+        }
+        let hi_p = p_at(eta_max);
+        if pressure_pa > hi_p {
+            return Err(InputError::new(
+                field,
+                format!("{pressure_pa} Pa is beyond the EOS's range (at most {hi_p:.4e} Pa)"),
+            ));
+        }
+        let (mut lo, mut hi) = (0.0, eta_max);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if p_at(mid) < pressure_pa {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(rho0 * (1.0 + 0.5 * (lo + hi)))
+    }
+
     /// Sound speed (m/s) at the fluid's own density ρ = ρ̄/ε: √(dp/dρ) of the EOS's cold curve,
     /// c0 at rest and in tension (for the CFL limit and c̄ of eq. 26).
     #[inline]

@@ -47,8 +47,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         &[25, 35, 50]
     };
-    // The water-jet blocks' DEM rows, at the DEM step limit or half of it.
-    let jet_dt = if a.quick { 1.0 } else { 0.5 };
+    // The water-jet blocks' DEM rows, at the DEM step limit or half of it; the water column's
+    // particles per height; the settling grain's steps per Stokes time.
+    let (jet_dt, jet_n, jet_settle) = if a.quick {
+        (1.0, 20, 100)
+    } else {
+        (0.5, 40, 400)
+    };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [
@@ -57,7 +62,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         ("hertz", Box::new(move || hertz::run(hertz_n))),
         ("impact", Box::new(move || elastic_impact::run(impact_n))),
         ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
-        ("jet", Box::new(move || jet::run(jet_dt))),
+        ("jet", Box::new(move || jet::run(jet_dt, jet_n, jet_settle))),
     ];
     for (name, f) in cases.iter() {
         if !want(name) {

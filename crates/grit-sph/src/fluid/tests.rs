@@ -178,3 +178,24 @@ fn shao_lo_term_is_nu_laplacian() {
 /// Bound on the relative error of the Shao–Lo sum for a parabolic profile on the square lattice
 /// at h = 1.25 Δx; it is −0.94 % (docs/jet.md#water).
 const SHAO_LO_LATTICE_TOL: f64 = 0.02;
+
+#[test]
+fn density_at_inverts_the_pressure() {
+    let w = Fluid::water();
+    for p in [w.min_pressure_pa, -5e4, 0.0, 98.1, 1e6, 1e8, 1e9] {
+        let rho = w.density_at(p, "p").unwrap();
+        let back = w.pressure(rho, 1.0, 0.0);
+        // One ulp of ρ near ρ0 is ρ0 c0² · 1.1e-16 = 2.4e-7 Pa.
+        assert!(
+            (back - p).abs() <= 1e-9 * p.abs() + 1e-6,
+            "p = {p}: rho = {rho}, back {back}"
+        );
+    }
+    // Beyond the law's rise, below the cavitation cut, not a number: errors on the field.
+    for p in [1e15, -2e5, f64::NAN] {
+        assert_eq!(
+            w.density_at(p, "x.pressure_pa[3]").unwrap_err().field,
+            "x.pressure_pa[3]"
+        );
+    }
+}

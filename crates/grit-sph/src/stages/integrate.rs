@@ -1,5 +1,5 @@
-//! Integration of the deformable particles (semi-implicit Euler) and the checks that end a step
-//! which has blown up.
+//! Integration of the deformable and fluid particles (semi-implicit Euler) and the checks that
+//! end a step which has blown up.
 
 use rayon::prelude::*;
 
@@ -25,9 +25,9 @@ struct Update {
     absorbed: f64,
 }
 
-/// Integrates deformable particles from `time` by `dt` (semi-implicit Euler) with the SPH
-/// accelerations `acc` and the contact forces `contact_force`, damped in absorbing layers; adds
-/// the layers' work to `absorbed`, in particle order. Then the failure checks: finite state,
+/// Integrates deformable and fluid particles from `time` by `dt` (semi-implicit Euler) with the
+/// SPH accelerations `acc` and the contact forces `contact_force`, damped in absorbing layers;
+/// adds the layers' work to `absorbed`, in particle order. Then the failure checks: finite state,
 /// positive density, no particle moved more than `h`, finite rigid bodies.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate(
@@ -46,6 +46,9 @@ pub(crate) fn integrate(
         .iter()
         .map(|b| match &b.kind {
             BodyKind::Deformable {
+                boundary_motion, ..
+            }
+            | BodyKind::Fluid {
                 boundary_motion, ..
             } => boundary_motion.velocity(t_next),
             _ => None,
@@ -67,7 +70,7 @@ pub(crate) fn integrate(
         .enumerate()
         .map(|(i, (x, v))| {
             let b = p.body[i] as usize;
-            if !bc[b].deformable {
+            if !bc[b].integrated() {
                 return Update {
                     failure: None,
                     absorbed: 0.0,

@@ -5,6 +5,7 @@
 mod ceiling;
 mod contact;
 mod density_filter;
+mod fluid;
 mod forces;
 mod integrate;
 mod kernel_sums;
@@ -17,6 +18,8 @@ pub(crate) use ceiling::ceiling;
 pub use ceiling::CeilingPass;
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
+use fluid::fluid_dt;
+pub(crate) use fluid::{fluid_accelerations, fluid_continuity, fluid_density, FluidConst};
 pub(crate) use forces::{forces, PairForce};
 pub(crate) use integrate::{integrate, Blowup};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};
@@ -95,6 +98,8 @@ pub(crate) struct BodyConst {
     /// Density up to which the EOS is evaluated: 0.9 of its singular compression, so a
     /// particle crushed beyond it gets a large finite pressure instead of a division by zero.
     pub rho_cap: f64,
+    /// The constants of a fluid body (AWJ paper eqs. 21–27); `None` for solids.
+    pub fluid: Option<FluidConst>,
 }
 
 impl BodyConst {
@@ -123,15 +128,30 @@ impl BodyConst {
             rho_cap: m.eos.map_or(f64::INFINITY, |e| {
                 e.reference_density() * (1.0 + 0.9 * e.singular_compression())
             }),
+            fluid: None,
         }
+    }
+
+    /// True for the particles the integration moves: deformable or fluid.
+    #[inline]
+    pub fn integrated(&self) -> bool {
+        self.deformable || self.fluid.is_some()
     }
 }
 
-/// The constants of each body, by body index (all zero and not deformable for a rigid body).
+/// The constants of each body, by body index (all zero and not deformable for a rigid body;
+/// a fluid body has only its `fluid` constants).
 pub(crate) fn body_consts(bodies: &[Body]) -> Vec<BodyConst> {
     bodies
         .iter()
-        .map(|b| b.material().map_or_else(BodyConst::default, BodyConst::of))
+        .map(|b| match (b.material(), b.fluid()) {
+            (Some(m), _) => BodyConst::of(m),
+            (None, Some(f)) => BodyConst {
+                fluid: Some(FluidConst::of(f)),
+                ..BodyConst::default()
+            },
+            (None, None) => BodyConst::default(),
+        })
         .collect()
 }
 

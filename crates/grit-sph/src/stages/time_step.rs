@@ -8,7 +8,8 @@ use crate::particles::Particles;
 use crate::world::Settings;
 
 /// Stable time step: CFL on the material signal speed plus particle speed over the smoothing
-/// length `h`, and the contact springs' period where `Settings::contact_limits_dt` asks for it.
+/// length `h`, the fluid's limits (`fluid_dt`), and the contact springs' period where
+/// `Settings::contact_limits_dt` asks for it.
 pub(crate) fn stable_dt(
     p: &Particles,
     bc: &[BodyConst],
@@ -25,6 +26,9 @@ pub(crate) fn stable_dt(
     let mut dt = settings.dt_max_s;
     if smax > 0.0 {
         dt = dt.min(settings.cfl * h / smax);
+    }
+    if bc.iter().any(|c| c.fluid.is_some()) {
+        dt = dt.min(super::fluid_dt(p, bc, h, settings.cfl));
     }
     for c in contacts.iter().filter(|_| settings.contact_limits_dt) {
         if c.min_mass.is_finite() {

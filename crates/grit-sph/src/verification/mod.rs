@@ -8,7 +8,9 @@ use serde::{Deserialize, Serialize};
 pub mod elastic_impact;
 pub mod hertz;
 pub mod hourglass;
+pub mod hydrostatic;
 pub mod jet;
+pub mod settling;
 pub mod sliding;
 pub mod slope;
 

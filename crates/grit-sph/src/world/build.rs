@@ -4,6 +4,7 @@ use super::World;
 use crate::body::{Absorber, Body, BodyKind, ExternalForce, Motion, Rigid};
 use crate::contact::{self, ContactPair, ContactParams};
 use crate::error::InputError;
+use crate::fluid::Fluid;
 use crate::geometry::Polygon;
 use crate::material::Material;
 use crate::math::{omega_cross, Matrix, Vector};
@@ -80,6 +81,7 @@ impl World {
         }
         let b = self.bodies.len();
         let rho = material.density_kg_m3;
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Deformable {
@@ -94,6 +96,111 @@ impl World {
             self.push_particle(b, *x, velocity_m_s, rho * v, rho, 0, Vector::zeros());
         }
         Ok(b)
+    }
+
+    /// Adds a fluid body (the AWJ paper eqs. 21–27) of particles at `points`, each standing for
+    /// `volume_m2` (area per unit depth) at gauge pressure `pressure_pa`: its density is the
+    /// EOS's at that pressure (`Fluid::density_at`) and its mass that density times the volume.
+    /// Walls that hold it are its own particles made kinematic (`set_kinematic`).
+    pub fn add_fluid(
+        &mut self,
+        name: &str,
+        fluid: Fluid,
+        points: &[Vector],
+        volume_m2: &[f64],
+        pressure_pa: &[f64],
+        velocity_m_s: Vector,
+    ) -> Result<usize, InputError> {
+        fluid.validate(&format!("{name}.fluid"))?;
+        if points.is_empty() {
+            return Err(InputError::new(
+                format!("{name}.points"),
+                "a body needs at least one particle",
+            ));
+        }
+        for (field, len) in [
+            ("volume_m2", volume_m2.len()),
+            ("pressure_pa", pressure_pa.len()),
+        ] {
+            if len != points.len() {
+                return Err(InputError::new(
+                    format!("{name}.{field}"),
+                    format!("needs one value per point ({}), got {len}", points.len()),
+                ));
+            }
+        }
+        if let Some(k) = points
+            .iter()
+            .position(|x| !(x.x.is_finite() && x.y.is_finite()))
+        {
+            return Err(InputError::new(
+                format!("{name}.points[{k}]"),
+                "must be finite",
+            ));
+        }
+        if let Some(k) = volume_m2.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(InputError::new(
+                format!("{name}.volume_m2[{k}]"),
+                "must be a finite number > 0",
+            ));
+        }
+        if !(velocity_m_s.x.is_finite() && velocity_m_s.y.is_finite()) {
+            return Err(InputError::new(
+                format!("{name}.velocity_m_s"),
+                "must be finite",
+            ));
+        }
+        let rho = pressure_pa
+            .iter()
+            .enumerate()
+            .map(|(k, &pr)| fluid.density_at(pr, &format!("{name}.pressure_pa[{k}]")))
+            .collect::<Result<Vec<f64>, InputError>>()?;
+        let rho0 = fluid.density();
+        let b = self.bodies.len();
+        self.consts = None;
+        self.bodies.push(Body {
+            name: name.to_string(),
+            kind: BodyKind::Fluid {
+                fluid,
+                boundary_motion: Motion::Fixed,
+            },
+            removed_mass_kg_m: 0.0,
+            removed_particles: 0,
+        });
+        for ((x, v), r) in points.iter().zip(volume_m2).zip(rho) {
+            self.push_particle(b, *x, velocity_m_s, r * v, r, 0, Vector::zeros());
+            // ρ0 is the fluid's reference density, not the initial one.
+            *self.particles.rho0.last_mut().expect("just pushed") = rho0;
+        }
+        Ok(b)
+    }
+
+    /// Sets the velocity of each free (not kinematic) particle of fluid body `b` to `field` at
+    /// its position; returns how many were set. A non-finite velocity is an error on
+    /// `<body>.velocity_m_s`, and nothing is changed.
+    pub fn set_fluid_velocity(
+        &mut self,
+        b: usize,
+        field: impl Fn(Vector) -> Vector,
+    ) -> Result<usize, InputError> {
+        let Some(body) = self.bodies.get(b).filter(|x| x.fluid().is_some()) else {
+            return Err(InputError::new("fluid_velocity", "needs a fluid body"));
+        };
+        let p = &self.particles;
+        let free: Vec<usize> = (0..p.len())
+            .filter(|&i| p.body[i] as usize == b && p.flags[i] & KINEMATIC == 0)
+            .collect();
+        let v: Vec<Vector> = free.iter().map(|&i| field(p.pos[i])).collect();
+        if v.iter().any(|v| !(v.x.is_finite() && v.y.is_finite())) {
+            return Err(InputError::new(
+                format!("{}.velocity_m_s", body.name),
+                "must be finite",
+            ));
+        }
+        for (&i, v) in free.iter().zip(v) {
+            self.particles.vel[i] = v;
+        }
+        Ok(free.len())
     }
 
     /// Adds a deformable body filling `polygon` on a square lattice of the world's spacing.
@@ -145,6 +252,7 @@ impl World {
             ));
         }
         let b = self.bodies.len();
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Deformable {
@@ -179,8 +287,9 @@ impl World {
         self.particles.select(&keep)
     }
 
-    /// Makes the particles of deformable body `b` that satisfy `select` kinematic: they move
-    /// with `motion` (a prescribed-motion boundary) and take no forces.
+    /// Makes the particles of deformable or fluid body `b` that satisfy `select` kinematic: they
+    /// move with `motion` (a prescribed-motion boundary) and take no forces. A fluid body's
+    /// kinematic particles are its walls: they still carry a density and a pressure.
     pub fn set_kinematic(
         &mut self,
         b: usize,
@@ -190,11 +299,14 @@ impl World {
         match &mut self.bodies[b].kind {
             BodyKind::Deformable {
                 boundary_motion, ..
+            }
+            | BodyKind::Fluid {
+                boundary_motion, ..
             } => *boundary_motion = motion,
             BodyKind::Rigid(_) => {
                 return Err(InputError::new(
                     "kinematic",
-                    "only deformable bodies have kinematic particles",
+                    "only deformable and fluid bodies have kinematic particles",
                 ))
             }
         }
@@ -271,6 +383,7 @@ impl World {
         let inertia = density_kg_m3 * polygon.polar_moment();
         let com = polygon.centroid();
         let b = self.bodies.len();
+        self.consts = None;
         self.bodies.push(Body {
             name: name.to_string(),
             kind: BodyKind::Rigid(Rigid {

@@ -10,7 +10,7 @@ use crate::particles::dev_contract;
 /// Energy of the world and what the numerics have added or taken (J/m, per unit depth).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Energy {
-    /// Kinetic energy of deformable particles and rigid bodies.
+    /// Kinetic energy of deformable and fluid particles and rigid bodies.
     pub kinetic: f64,
     /// Elastic strain energy: V (p²/2K + s:s/4G) summed over deformable particles.
     pub elastic: f64,
@@ -46,11 +46,17 @@ pub struct NumericalWork {
 impl World {
     /// Kinetic, elastic, contact-spring and gravity energy (J/m).
     pub fn energy(&self) -> Energy {
-        let bc = crate::stages::body_consts(&self.bodies);
+        let bc = self.body_consts();
         let p = &self.particles;
         let mut e = Energy::default();
         for i in 0..p.len() {
             let b = p.body[i] as usize;
+            if bc[b].fluid.is_some() {
+                // The fluid's compression energy is not booked.
+                e.kinetic += 0.5 * p.mass[i] * p.vel[i].norm_squared();
+                e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
+                continue;
+            }
             if !bc[b].deformable {
                 continue;
             }
@@ -80,12 +86,14 @@ impl World {
         e
     }
 
-    /// Total linear momentum of deformable particles and free rigid bodies (kg·m/s per m).
+    /// Total linear momentum of deformable and fluid particles and free rigid bodies (kg·m/s
+    /// per m).
     pub fn momentum(&self) -> Vector {
         let p = &self.particles;
         let mut m = Vector::zeros();
         for i in 0..p.len() {
-            if self.bodies[p.body[i] as usize].material().is_some() {
+            let b = &self.bodies[p.body[i] as usize];
+            if b.material().is_some() || b.fluid().is_some() {
                 m += p.vel[i] * p.mass[i];
             }
         }

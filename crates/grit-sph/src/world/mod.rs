@@ -43,6 +43,8 @@ struct Scratch {
     acc: Vec<Vector>,
     /// Contact force on each particle.
     contact_force: Vec<Vector>,
+    /// Continuity rates dρ̄/dt of the fluid particles (the fluid stage fills it).
+    drho: Vec<f64>,
 }
 
 /// A 2D SPH scene: bodies, their particles, contact pairs, time.
@@ -68,6 +70,11 @@ pub struct World {
     scratch: Scratch,
     #[serde(skip)]
     timers: Timers,
+    /// The bodies' constants (`stages::body_consts`), kept between steps: a fluid's EOS scans
+    /// for its singular compression, thousands of evaluations. `None` whenever a body may have
+    /// changed (`body_mut`, a body added).
+    #[serde(skip)]
+    consts: Option<Vec<BodyConst>>,
 }
 
 impl World {
@@ -91,6 +98,7 @@ impl World {
             nbrs_valid: false,
             scratch: Scratch::default(),
             timers: Timers::default(),
+            consts: None,
         })
     }
 
@@ -112,6 +120,7 @@ impl World {
     }
     /// One body, mutable (to change a rigid body's motion or external force between phases).
     pub fn body_mut(&mut self, b: usize) -> &mut Body {
+        self.consts = None;
         &mut self.bodies[b]
     }
     /// All particles.
@@ -159,6 +168,24 @@ impl World {
         self.nbrs.pairs()
     }
 
+    /// The bodies' constants, from the kept copy when there is one.
+    pub(crate) fn body_consts(&self) -> Vec<BodyConst> {
+        self.consts
+            .clone()
+            .unwrap_or_else(|| stages::body_consts(&self.bodies))
+    }
+
+    /// Computes the bodies' constants once and keeps them until a body changes.
+    fn keep_body_consts(&mut self) {
+        if self
+            .consts
+            .as_ref()
+            .is_none_or(|c| c.len() != self.bodies.len())
+        {
+            self.consts = Some(stages::body_consts(&self.bodies));
+        }
+    }
+
     /// Reach of the neighbour lists: the kernel support plus the Verlet skin.
     fn neighbour_reach(&self) -> f64 {
         self.kernel.radius() + self.settings.skin_over_dx * self.settings.spacing_m
@@ -189,7 +216,7 @@ impl World {
     /// Stable time step: CFL on the material signal speed plus particle speed, and the
     /// contact springs' period.
     fn compute_dt(&self) -> f64 {
-        let bc = stages::body_consts(&self.bodies);
+        let bc = self.body_consts();
         stages::stable_dt(
             &self.particles,
             &bc,
@@ -225,7 +252,8 @@ impl World {
         }
         let dt = self.dt;
         let n = self.particles.len();
-        let bc = stages::body_consts(&self.bodies);
+        self.keep_body_consts();
+        let bc = self.body_consts();
 
         let mut timers = std::mem::take(&mut self.timers);
         if self.needs_rebuild() {
@@ -258,7 +286,8 @@ impl World {
             self.dt = self.compute_dt();
         }
         let dt = self.dt;
-        let bc = stages::body_consts(&self.bodies);
+        self.keep_body_consts();
+        let bc = self.body_consts();
         let ready = self.nbrs_valid && self.scratch.pairs.count.len() == self.particles.len();
         if stage != Stage::Neighbours && !ready {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
@@ -344,7 +373,8 @@ impl World {
     /// Runs the configured density filter now (eq. 12, or its MLS form) and books the change
     /// of elastic energy as the filter's work; `step` calls it every `shepard_interval` steps.
     pub fn filter_density(&mut self) {
-        let bc = stages::body_consts(&self.bodies);
+        self.keep_body_consts();
+        let bc = self.body_consts();
         self.filter_density_with(&bc);
     }
 
@@ -395,6 +425,17 @@ impl World {
             dt,
         );
         self.work.plastic -= plastic_work;
+        if bc.iter().any(|c| c.fluid.is_some()) {
+            let s = SphView {
+                p: &self.particles,
+                nl: &self.nbrs.same,
+                k: &self.kernel,
+                bc,
+            };
+            let sc = &mut self.scratch;
+            stages::fluid_continuity(s, &self.nbrs.half, &sc.pairs, &mut sc.drho);
+            stages::fluid_density(&mut self.particles, bc, &sc.drho, dt);
+        }
     }
 
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
@@ -419,6 +460,10 @@ impl World {
             &mut sc.pair_forces,
         );
         self.work.hourglass += hg;
+        if bc.iter().any(|c| c.fluid.is_some()) {
+            let g = self.settings.gravity_m_s2;
+            stages::fluid_accelerations(s, &self.nbrs.half, &sc.pairs, g, &mut sc.acc);
+        }
     }
 
     fn contact(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {

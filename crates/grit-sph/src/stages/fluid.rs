@@ -1,0 +1,227 @@
+//! The fluid's parts of the step (the AWJ paper eqs. 22–27, docs/jet.md#water-in-the-engine):
+//! the continuity rate of the porosity-weighted density ρ̄ and its update, then the
+//! accelerations from the updated density, both summed over the same-body pairs the kernel
+//! sums cached, and the fluid's time-step limits.
+//!
+//! Until grains join the world the porosity is ε = 1 everywhere, so ρ̄ is the fluid's own
+//! density; the sums already carry ρ̄ where the paper does.
+
+use rayon::prelude::*;
+
+use super::pairs::{HalfPair, PairCache};
+use super::{BodyConst, ParTasks, SphView};
+use crate::eos::MieGruneisen;
+use crate::fluid::{self, ArtificialViscosity, Fluid};
+use crate::math::Vector;
+use crate::neighbours::HalfIndex;
+use crate::particles::{Particles, KINEMATIC};
+
+/// The porosity the fluid stage uses until grains join the world (AWJ paper eq. 20 with no
+/// grains).
+const NO_GRAINS_POROSITY: f64 = 1.0;
+
+/// The constants of a fluid body the stages read, copied out of its [`Fluid`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FluidConst {
+    eos: MieGruneisen,
+    min_pressure: f64,
+    /// Kinematic viscosity ν = μ/ρ0 of the Shao–Lo term (eq. 25).
+    pub nu: f64,
+    av: ArtificialViscosity,
+    /// Density up to which the EOS is evaluated: 0.9 of its singular compression, so a particle
+    /// crushed beyond it gets a large finite pressure instead of a division by zero.
+    rho_cap: f64,
+}
+
+impl FluidConst {
+    /// The constants of `f`.
+    pub fn of(f: &Fluid) -> FluidConst {
+        FluidConst {
+            eos: f.eos,
+            min_pressure: f.min_pressure_pa,
+            nu: f.kinematic_viscosity(),
+            av: f.artificial_viscosity,
+            rho_cap: f.eos.rho0_kg_m3 * (1.0 + 0.9 * f.eos.singular_compression()),
+        }
+    }
+
+    /// `Fluid::pressure` (eq. 24 at ρ = ρ̄/ε, cut at the cavitation pressure) with e = 0 and
+    /// the density capped below the singular compression.
+    #[inline]
+    pub fn pressure(&self, rho_bar: f64, porosity: f64) -> f64 {
+        self.eos
+            .pressure((rho_bar / porosity).min(self.rho_cap), 0.0)
+            .max(self.min_pressure)
+    }
+
+    /// `Fluid::sound_speed` (the cold curve's √(dp/dρ) at ρ = ρ̄/ε), capped like the pressure.
+    #[inline]
+    pub fn sound_speed(&self, rho_bar: f64, porosity: f64) -> f64 {
+        self.eos.sound_speed((rho_bar / porosity).min(self.rho_cap))
+    }
+}
+
+/// The used same-body pairs of particle `i` this step, seen from `i`: (j, pair).
+fn pairs_of<'a>(
+    s: SphView<'a>,
+    hi: &'a HalfIndex,
+    cache: &'a PairCache,
+    i: usize,
+) -> impl Iterator<Item = (usize, HalfPair)> + 'a {
+    let nl = s.nl;
+    let ids = &hi.id[nl.start[i] as usize..];
+    nl.of(i).iter().zip(ids).filter_map(move |(&j, &id)| {
+        let pair = cache.half[id as usize];
+        (pair.used && pair.r > 0.0).then(|| (j as usize, pair.seen((j as usize) < i)))
+    })
+}
+
+/// Continuity rates dρ̄/dt (eq. 22) of every fluid particle, walls included, into `drho` (0 for
+/// the other particles), from the pairs `cache` holds for this step (`hi` names them); each
+/// particle gathers its pairs in its own row's order.
+pub(crate) fn fluid_continuity(
+    s: SphView<'_>,
+    hi: &HalfIndex,
+    cache: &PairCache,
+    drho: &mut Vec<f64>,
+) {
+    let p = s.p;
+    drho.clear();
+    drho.par_extend((0..p.len()).into_par_iter().par_tasks().map(|i| {
+        if s.bc[p.body[i] as usize].fluid.is_none() {
+            return 0.0;
+        }
+        let (rho_a, v_a) = (p.rho[i], p.vel[i]);
+        pairs_of(s, hi, cache, i)
+            .map(|(j, pair)| {
+                let grad = pair.xij * pair.dw_r;
+                fluid::continuity_rate(rho_a, p.mass[j], p.rho[j], v_a - p.vel[j], grad)
+            })
+            .sum()
+    }));
+}
+
+/// Accelerations of the free fluid particles into `accel`: pressure gradient (eq. 23) with the
+/// pressure of eq. 24, Shao–Lo laminar viscosity (eq. 25), Monaghan artificial viscosity
+/// (eqs. 26–27) and gravity `g`. Kinematic fluid particles (the walls) and the other bodies'
+/// particles keep what `accel` holds. Reads the densities after this step's continuity
+/// update, so density and velocity advance as a symplectic pair.
+pub(crate) fn fluid_accelerations(
+    s: SphView<'_>,
+    hi: &HalfIndex,
+    cache: &PairCache,
+    g: Vector,
+    accel: &mut [Vector],
+) {
+    let SphView { p, k, bc, .. } = s;
+    let h = k.h;
+    let fc = |i: usize| bc[p.body[i] as usize].fluid;
+    // Pressure and sound speed once per particle, read by each of its pairs.
+    let state: Vec<(f64, f64)> = (0..p.len())
+        .into_par_iter()
+        .par_tasks()
+        .map(|i| {
+            fc(i).map_or((0.0, 0.0), |f| {
+                (
+                    f.pressure(p.rho[i], NO_GRAINS_POROSITY),
+                    f.sound_speed(p.rho[i], NO_GRAINS_POROSITY),
+                )
+            })
+        })
+        .collect();
+    accel
+        .par_iter_mut()
+        .par_tasks()
+        .enumerate()
+        .for_each(|(i, acc)| {
+            let Some(f) = fc(i) else { return };
+            if p.flags[i] & KINEMATIC != 0 {
+                return;
+            }
+            let (rho_a, (p_a, c_a), v_a) = (p.rho[i], state[i], p.vel[i]);
+            let mut a = Vector::zeros();
+            for (j, pair) in pairs_of(s, hi, cache, i) {
+                let (m_b, rho_b, (p_b, c_b)) = (p.mass[j], p.rho[j], state[j]);
+                let grad = pair.xij * pair.dw_r;
+                let v_ab = v_a - p.vel[j];
+                a += fluid::pressure_acceleration(m_b, p_a, rho_a, p_b, rho_b, grad);
+                a += fluid::shao_lo_acceleration(f.nu, m_b, rho_a, rho_b, pair.xij, v_ab, grad, h);
+                let pi =
+                    f.av.pi_ab(pair.xij, v_ab, 0.5 * (c_a + c_b), 0.5 * (rho_a + rho_b), h);
+                a += fluid::artificial_viscosity_acceleration(m_b, pi, grad);
+            }
+            *acc = a + g;
+        });
+}
+
+/// Advances the density ρ̄ of every fluid particle by `dt` with the rates `drho` of
+/// [`fluid_continuity`], before the accelerations read it (as the solid's stress stage
+/// advances ρ before its forces).
+pub(crate) fn fluid_density(p: &mut Particles, bc: &[BodyConst], drho: &[f64], dt: f64) {
+    p.rho
+        .par_iter_mut()
+        .zip(p.body.par_iter())
+        .zip(drho.par_iter())
+        .par_tasks()
+        .for_each(|((rho, &b), &rate)| {
+            if bc[b as usize].fluid.is_some() {
+                *rho += rate * dt;
+            }
+        });
+}
+
+/// The smallest time step the fluid particles allow (s; ∞ without any): the CFL limit
+/// `cfl` · h / max(c + |v|) with c the EOS's sound speed at each particle's density, and the
+/// viscous diffusion limit 0.125 h²/ν of an explicit step (Morris, Fox & Zhu 1997).
+pub(crate) fn fluid_dt(p: &Particles, bc: &[BodyConst], h: f64, cfl: f64) -> f64 {
+    let fc = |i: usize| bc[p.body[i] as usize].fluid;
+    let smax = (0..p.len())
+        .into_par_iter()
+        .par_tasks()
+        .filter_map(|i| {
+            fc(i).map(|f| f.sound_speed(p.rho[i], NO_GRAINS_POROSITY) + p.vel[i].norm())
+        })
+        .reduce(|| 0.0, f64::max);
+    let nu_max = bc
+        .iter()
+        .filter_map(|c| c.fluid.map(|f| f.nu))
+        .fold(0.0, f64::max);
+    let mut dt = f64::INFINITY;
+    if smax > 0.0 {
+        dt = cfl * h / smax;
+    }
+    if nu_max > 0.0 {
+        dt = dt.min(0.125 * h * h / nu_max);
+    }
+    dt
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_engine_s_pressure_is_the_fluid_s() {
+        let w = Fluid::water();
+        let c = FluidConst::of(&w);
+        for rho in [990.0, 999.99, 1000.0, 1000.1, 1010.0, 1200.0] {
+            assert_eq!(
+                c.pressure(rho, 1.0).to_bits(),
+                w.pressure(rho, 1.0, 0.0).to_bits()
+            );
+            assert_eq!(
+                c.sound_speed(rho, 1.0).to_bits(),
+                w.sound_speed(rho, 1.0).to_bits()
+            );
+        }
+        // A law that turns singular: crushed beyond 0.9 of it, large, finite and no larger.
+        let mut f = Fluid::water();
+        f.eos.s2 = 0.0;
+        f.eos.s3 = 0.0;
+        let c = FluidConst::of(&f);
+        let eta_s = f.eos.singular_compression();
+        let crushed = c.pressure(1000.0 * (1.0 + 1.1 * eta_s), 1.0);
+        assert!(crushed.is_finite() && crushed > 0.0);
+        assert_eq!(crushed, c.pressure(1000.0 * (1.0 + 0.9 * eta_s), 1.0));
+    }
+}
