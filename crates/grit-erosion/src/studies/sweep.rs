@@ -208,6 +208,14 @@ pub struct SweepRow {
     pub hertz_per_radius: usize,
     /// Why the Hertz case gave no error, when it failed.
     pub hertz_failure: Option<String>,
+    /// Whether the erosion's last-20 window passed the steady-state check of its mean series
+    /// (`steady::assess`, seed section 4); absent in files written before it was recorded.
+    #[serde(default)]
+    pub steady: Option<bool>,
+    /// Mean over samples of the first impact with mass loss (the incubation); absent when no
+    /// sample lost mass or in older files.
+    #[serde(default)]
+    pub first_loss_mean_impact: Option<f64>,
 }
 
 /// Runs `samples` samples of `impacts` impacts of `base` at spacing `Dg / ppd` under `variant`,
@@ -314,6 +322,12 @@ pub fn run_resolution(
         hertz_p0_error,
         hertz_per_radius,
         hertz_failure,
+        steady: agg.steady_state.as_ref().map(|s| s.steady),
+        first_loss_mean_impact: agg
+            .steady_state
+            .as_ref()
+            .and_then(|s| s.incubation_impacts.as_ref())
+            .map(|i| i.mean),
     })
 }
 
@@ -544,8 +558,13 @@ impl SweepRow {
             r.samples_with_loss,
             r.samples,
             r.hertz_p0_error
-                .map_or_else(|| r.hertz_failure.clone().unwrap_or_default(), |e| format!("{:.1} % at {} per radius", e * 100.0, r.hertz_per_radius))
-        )
+                .map_or_else(|| r.hertz_failure.clone().unwrap_or_default(), |e| format!("{:.1} % at {} per radius", e * 100.0, r.hertz_per_radius)),
+        ) + &match (r.steady, r.first_loss_mean_impact) {
+            (Some(true), Some(f)) => format!("  steady (first loss at impact {f:.0} on average)"),
+            (Some(false), Some(f)) => format!("  NOT steady (first loss at impact {f:.0} on average)"),
+            (Some(false), None) => "  NOT steady (no sample lost mass)".to_string(),
+            _ => String::new(),
+        }
     }
 }
 
@@ -621,6 +640,8 @@ mod tests {
             hertz_p0_error: None,
             hertz_per_radius: ppd as usize,
             hertz_failure: None,
+            steady: None,
+            first_loss_mean_impact: None,
         }
     }
 
