@@ -167,10 +167,10 @@ pub(crate) fn wall_forces(
 ) {
     out.clear();
     out.resize(bc.len(), Vector::zeros());
-    for i in 0..p.len() {
+    for (i, a) in accel.iter().enumerate().take(p.len()) {
         let b = p.body[i] as usize;
         if bc[b].fluid.is_some() && p.flags[i] & KINEMATIC != 0 {
-            out[b] += accel[i] * p.mass[i];
+            out[b] += a * p.mass[i];
         }
     }
 }

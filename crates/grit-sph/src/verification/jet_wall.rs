@@ -58,7 +58,7 @@ pub struct JetWallRun {
 /// [`JET_B`] at `speed` m/s, with water `water`: cubic spline, h = 1.25 Δx, CFL 0.2, no
 /// gravity. The nozzle is added last, so its first row is in the world.
 pub fn jet_wall_world(n: usize, speed: f64, water: Fluid) -> Result<World, SimError> {
-    if n < 2 || n % 2 != 0 {
+    if n < 2 || !n.is_multiple_of(2) {
         return Err(fail(format!("jet_wall: n = {n}; needs an even n >= 2")));
     }
     let dx = JET_B / n as f64;

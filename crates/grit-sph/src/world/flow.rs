@@ -212,15 +212,15 @@ impl World {
             let p = &self.particles;
             let mut keep = vec![true; p.len()];
             for o in &mut self.flow.outflows {
-                for i in 0..p.len() {
+                for (i, kept) in keep.iter_mut().enumerate() {
                     let x = p.pos[i];
                     let inside = x.x >= o.min_m.x
                         && x.x <= o.max_m.x
                         && x.y >= o.min_m.y
                         && x.y <= o.max_m.y;
                     let free = p.flags[i] & KINEMATIC == 0;
-                    if keep[i] && free && p.body[i] as usize == o.body && !inside {
-                        keep[i] = false;
+                    if *kept && free && p.body[i] as usize == o.body && !inside {
+                        *kept = false;
                         o.particles += 1;
                         o.mass_kg_m += p.mass[i];
                     }
