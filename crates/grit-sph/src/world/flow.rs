@@ -202,12 +202,11 @@ impl World {
     }
 
     /// The open boundaries' part of a step of `dt`: outflows delete, then inflows release the
-    /// rows whose predecessors have moved a spacing. Returns whether particles changed.
-    pub(super) fn flow_step(&mut self, dt: f64) -> bool {
+    /// rows whose predecessors have moved a spacing.
+    pub(super) fn flow_step(&mut self, dt: f64) {
         if self.flow.is_empty() {
-            return false;
+            return;
         }
-        let mut changed = false;
         if !self.flow.outflows.is_empty() {
             let p = &self.particles;
             let mut keep = vec![true; p.len()];
@@ -228,7 +227,6 @@ impl World {
             }
             if keep.iter().any(|k| !k) {
                 self.retain_particles(&keep);
-                changed = true;
             }
         }
         let dx = self.settings.spacing_m;
@@ -240,9 +238,7 @@ impl World {
                 inflow.travelled_m = (inflow.travelled_m - dx).max(0.0);
                 let s = inflow.travelled_m;
                 self.release_row(k, s);
-                changed = true;
             }
         }
-        changed
     }
 }
