@@ -36,5 +36,7 @@ pub use kernel::{Kernel, KernelKind};
 pub use math::{Matrix, Vector};
 pub use particles::Particles;
 pub use timers::{Stage, Timers};
-pub use world::{CeilingPass, DensityFilter, Energy, NumericalWork, Settings, World};
+pub use world::{
+    CeilingPass, DensityFilter, Energy, Inflow, Nozzle, NumericalWork, Outflow, Settings, World,
+};
 pub mod verification;

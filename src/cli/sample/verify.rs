@@ -48,12 +48,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         &[25, 35, 50]
     };
     // The water-jet blocks' DEM rows, at the DEM step limit or half of it; the water column's
-    // particles per height; the settling grain's steps per Stokes time.
+    // particles per height; the settling grain's steps per Stokes time; the jet on a wall's
+    // particles across the jet and its speed.
     let (jet_dt, jet_n, jet_settle) = if a.quick {
         (1.0, 20, 100)
     } else {
         (0.5, 40, 400)
     };
+    let (wall_n, wall_v) = if a.quick { (16, 400.0) } else { (24, 400.0) };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [
@@ -62,7 +64,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         ("hertz", Box::new(move || hertz::run(hertz_n))),
         ("impact", Box::new(move || elastic_impact::run(impact_n))),
         ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
-        ("jet", Box::new(move || jet::run(jet_dt, jet_n, jet_settle))),
+        (
+            "jet",
+            Box::new(move || jet::run(jet_dt, jet_n, jet_settle, wall_n, wall_v)),
+        ),
     ];
     for (name, f) in cases.iter() {
         if !want(name) {

@@ -101,11 +101,12 @@ pub(crate) fn fluid_continuity(
     }));
 }
 
-/// Accelerations of the free fluid particles into `accel`: pressure gradient (eq. 23) with the
+/// Accelerations of the fluid particles into `accel`: pressure gradient (eq. 23) with the
 /// pressure of eq. 24, Shao–Lo laminar viscosity (eq. 25), Monaghan artificial viscosity
-/// (eqs. 26–27) and gravity `g`. Kinematic fluid particles (the walls) and the other bodies'
-/// particles keep what `accel` holds. Reads the densities after this step's continuity
-/// update, so density and velocity advance as a symplectic pair.
+/// (eqs. 26–27) and gravity `g`. Kinematic fluid particles (the walls) get the pair terms
+/// alone, which the integration ignores and [`wall_forces`] sums; the other bodies' particles
+/// keep what `accel` holds. Reads the densities after this step's continuity update, so density
+/// and velocity advance as a symplectic pair.
 pub(crate) fn fluid_accelerations(
     s: SphView<'_>,
     hi: &HalfIndex,
@@ -135,9 +136,6 @@ pub(crate) fn fluid_accelerations(
         .enumerate()
         .for_each(|(i, acc)| {
             let Some(f) = fc(i) else { return };
-            if p.flags[i] & KINEMATIC != 0 {
-                return;
-            }
             let (rho_a, (p_a, c_a), v_a) = (p.rho[i], state[i], p.vel[i]);
             let mut a = Vector::zeros();
             for (j, pair) in pairs_of(s, hi, cache, i) {
@@ -150,8 +148,31 @@ pub(crate) fn fluid_accelerations(
                     f.av.pi_ab(pair.xij, v_ab, 0.5 * (c_a + c_b), 0.5 * (rho_a + rho_b), h);
                 a += fluid::artificial_viscosity_acceleration(m_b, pi, grad);
             }
-            *acc = a + g;
+            *acc = if p.flags[i] & KINEMATIC != 0 {
+                a
+            } else {
+                a + g
+            };
         });
+}
+
+/// Per body, Σ m a over its kinematic fluid particles, from the pair accelerations of
+/// [`fluid_accelerations`]: the force its fluid puts on its walls (N/m; zero for bodies without
+/// walls). Summed serially in particle order, so the bits do not depend on the thread count.
+pub(crate) fn wall_forces(
+    p: &Particles,
+    bc: &[BodyConst],
+    accel: &[Vector],
+    out: &mut Vec<Vector>,
+) {
+    out.clear();
+    out.resize(bc.len(), Vector::zeros());
+    for (i, a) in accel.iter().enumerate().take(p.len()) {
+        let b = p.body[i] as usize;
+        if bc[b].fluid.is_some() && p.flags[i] & KINEMATIC != 0 {
+            out[b] += a * p.mass[i];
+        }
+    }
 }
 
 /// Advances the density ρ̄ of every fluid particle by `dt` with the rates `drho` of

@@ -19,7 +19,9 @@ pub use ceiling::CeilingPass;
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
 use fluid::fluid_dt;
-pub(crate) use fluid::{fluid_accelerations, fluid_continuity, fluid_density, FluidConst};
+pub(crate) use fluid::{
+    fluid_accelerations, fluid_continuity, fluid_density, wall_forces, FluidConst,
+};
 pub(crate) use forces::{forces, PairForce};
 pub(crate) use integrate::{integrate, Blowup};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};

@@ -1,7 +1,8 @@
 //! Checks of the water-jet scene's building blocks with analytic references (docs/jet.md):
 //! the copper Hugoniot of the Mie–Grüneisen EOS, the DEM drop of the AWJ paper's Fig. 4, the
-//! head-on restitution of two grains, the water column at rest (`super::hydrostatic`) and a
-//! grain settling through the coupling (`super::settling`).
+//! head-on restitution of two grains, the water column at rest (`super::hydrostatic`), a
+//! grain settling through the coupling (`super::settling`) and a jet on a wall
+//! (`super::jet_wall`).
 
 use super::{CaseReport, Chart, Row, Series};
 use crate::dem::{contact_time, damping_ratio, Dem, DemParams, Grain, Wall};
@@ -37,8 +38,15 @@ fn fail(what: String) -> SimError {
 }
 
 /// Runs all rows; the DEM steps are `dt_scale` × `Dem::time_step()`, the water column is
-/// `hydro_n` particles high, the settling grain takes `settle_steps` steps per Stokes time.
-pub fn run(dt_scale: f64, hydro_n: usize, settle_steps: usize) -> Result<CaseReport, SimError> {
+/// `hydro_n` particles high, the settling grain takes `settle_steps` steps per Stokes time, and
+/// the jet on a wall has `wall_n` particles across at `wall_speed` m/s.
+pub fn run(
+    dt_scale: f64,
+    hydro_n: usize,
+    settle_steps: usize,
+    wall_n: usize,
+    wall_speed: f64,
+) -> Result<CaseReport, SimError> {
     let mut rep = hugoniot()?;
     rep.extend(dem_drop(dt_scale)?);
     for e in [0.3, 0.8, 0.95] {
@@ -46,6 +54,7 @@ pub fn run(dt_scale: f64, hydro_n: usize, settle_steps: usize) -> Result<CaseRep
     }
     rep.extend(super::hydrostatic::hydrostatic(hydro_n)?);
     rep.extend(super::settling::settling(settle_steps)?);
+    rep.extend(super::jet_wall::jet_wall(wall_n, wall_speed)?);
     Ok(rep)
 }
 
@@ -323,8 +332,8 @@ mod tests {
 
     #[test]
     fn every_row_meets_its_tolerance() {
-        let rep = run(1.0, 12, 100).unwrap();
-        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3);
+        let rep = run(1.0, 12, 100, 16, 400.0).unwrap();
+        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 2);
         for r in &rep.rows {
             assert!(
                 r.pass != r.expected_fail,
@@ -335,7 +344,7 @@ mod tests {
             );
             assert!(r.case.starts_with("jet_"));
         }
-        assert_eq!(rep.charts.len(), 3);
+        assert_eq!(rep.charts.len(), 4);
     }
 
     #[test]

@@ -12,7 +12,7 @@ use crate::particles::{Particles, BOUNDARY, KINEMATIC};
 
 impl World {
     #[allow(clippy::too_many_arguments)]
-    fn push_particle(
+    pub(super) fn push_particle(
         &mut self,
         body: usize,
         x: Vector,

@@ -7,10 +7,12 @@
 
 mod build;
 mod diagnostics;
+mod flow;
 mod settings;
 
 pub use crate::stages::{CeilingPass, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 pub use diagnostics::{Energy, NumericalWork};
+pub use flow::{Inflow, Nozzle, Outflow};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
 
 use serde::{Deserialize, Serialize};
@@ -45,6 +47,8 @@ struct Scratch {
     contact_force: Vec<Vector>,
     /// Continuity rates dρ̄/dt of the fluid particles (the fluid stage fills it).
     drho: Vec<f64>,
+    /// Per body, the force the fluid's pair terms put on its kinematic particles.
+    wall_force: Vec<Vector>,
 }
 
 /// A 2D SPH scene: bodies, their particles, contact pairs, time.
@@ -62,6 +66,9 @@ pub struct World {
     work: NumericalWork,
     /// Positions at the last neighbour build.
     x_build: Vec<Vector>,
+    /// Inflows and outflows of fluid bodies; absent from the JSON of a world without any.
+    #[serde(default, skip_serializing_if = "flow::Flow::is_empty")]
+    flow: flow::Flow,
     #[serde(skip)]
     nbrs: WorldLists,
     #[serde(skip)]
@@ -94,6 +101,7 @@ impl World {
             next_id: 0,
             work: NumericalWork::default(),
             x_build: Vec::new(),
+            flow: flow::Flow::default(),
             nbrs: WorldLists::default(),
             nbrs_valid: false,
             scratch: Scratch::default(),
@@ -162,6 +170,16 @@ impl World {
     /// Contact force on each particle in the last step (N/m); empty before the first step.
     pub fn contact_forces(&self) -> &[Vector] {
         &self.scratch.contact_force
+    }
+    /// Force per unit depth (N/m) that the pair terms of the fluid (the AWJ paper eqs. 23,
+    /// 25–27) put on the kinematic particles of body `b` in the last step: the load on a fluid's
+    /// walls. Zero before the first step and for other bodies.
+    pub fn wall_force(&self, b: usize) -> Vector {
+        self.scratch
+            .wall_force
+            .get(b)
+            .copied()
+            .unwrap_or_else(Vector::zeros)
     }
     /// Neighbour count of each particle as last built (for reports).
     pub fn neighbour_pairs(&self) -> usize {
@@ -274,7 +292,7 @@ impl World {
         let mut timers = std::mem::take(&mut self.timers);
         let r = timers.time(Stage::Housekeeping, || self.housekeeping(&bc));
         self.timers = timers;
-        debug_assert!(self.particles.len() <= n);
+        debug_assert!(self.particles.len() <= n || !self.flow.inflows.is_empty());
         r
     }
 
@@ -366,6 +384,7 @@ impl World {
             let keep: Vec<bool> = failed.iter().map(|f| !f).collect();
             self.retain_particles(&keep);
         }
+        self.flow_step(self.dt);
         self.dt = self.compute_dt();
         Ok(())
     }
@@ -463,6 +482,7 @@ impl World {
         if bc.iter().any(|c| c.fluid.is_some()) {
             let g = self.settings.gravity_m_s2;
             stages::fluid_accelerations(s, &self.nbrs.half, &sc.pairs, g, &mut sc.acc);
+            stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_force);
         }
     }
 
