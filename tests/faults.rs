@@ -149,7 +149,11 @@ async fn coordinator_killed_twice_mid_campaign_loses_and_repeats_nothing() {
 async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let spec = campaign(1, 8);
+    // Enough impacts that the job outlives the first freeze and the poll after it: during a
+    // freeze each impact waits out a 1 s heartbeat timeout, after it the impacts run at full
+    // speed (tens of milliseconds each at this spacing).
+    let impacts = 40;
+    let spec = campaign(1, impacts);
     // A 12 s lease is renewed every 4 s; a 5 s freeze spans at least one heartbeat (which
     // times out after 1 s) yet leaves the lease alive: the last renewal is at most 4 s
     // before the freeze and the next at most 4 s after it.
@@ -186,7 +190,7 @@ async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit()
     tokio::time::sleep(Duration::from_secs_f64(lease_s + 2.0)).await;
     signal(&coord.proc, "CONT");
     let s = wait_done(&c, id, Duration::from_secs(180)).await;
-    assert_eq!(s.impacts_done, 8);
+    assert_eq!(s.impacts_done, impacts as u64);
     let log = w.log_text();
     assert!(
         log.contains("job dropped") && log.contains("409"),
@@ -197,7 +201,7 @@ async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit()
         "the job was resumed from its checkpoint:\n{log}"
     );
     assert_alive(&mut [&mut w]);
-    assert_matches_grit_run(&c, id, dir.path(), &spec, 8).await;
+    assert_matches_grit_run(&c, id, dir.path(), &spec, impacts).await;
 }
 
 /// A tmpfs mounted by the test, unmounted on drop.
