@@ -1,9 +1,11 @@
 //! Inflow and outflow of a fluid body (docs/jet.md#inflow-and-outflow): rows released at the
 //! expected times and places, deletion and its booking, mass balance, determinism, input errors.
 
+mod common;
+
 use grit_sph::particles::KINEMATIC;
 use grit_sph::verification::jet_wall::jet_wall_world;
-use grit_sph::{Fluid, KernelKind, Motion, Nozzle, Settings, Vector, World};
+use grit_sph::{Fluid, Motion, Nozzle, Settings, Vector, World};
 
 const DX: f64 = 1e-4;
 const SPEED: f64 = 50.0;
@@ -12,15 +14,7 @@ const PER_ROW: usize = 4;
 /// A fluid body of one fixed anchor particle behind a nozzle at the origin that shoots
 /// `PER_ROW` particles per row along +x; no gravity.
 fn nozzle_world() -> World {
-    let settings = Settings {
-        spacing_m: DX,
-        h_over_dx: 1.25,
-        kernel: KernelKind::CubicSpline,
-        cfl: 0.2,
-        gravity_m_s2: Vector::zeros(),
-        shepard_interval: 0,
-        ..Settings::default()
-    };
+    let settings = Settings::water_jet(DX, Vector::zeros());
     let mut w = World::new(settings).unwrap();
     let anchor = [Vector::new(-20.0 * DX, 0.0)];
     let b = w
@@ -138,16 +132,8 @@ fn outflow_deletes_books_and_balances_the_mass() {
 }
 
 fn jet_on_wall(threads: usize) -> World {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
-        let mut w = jet_wall_world(4, 400.0, Fluid::water()).unwrap();
-        for _ in 0..600 {
-            w.step().unwrap();
-        }
-        w
+    common::stepped_on(threads, 600, || {
+        jet_wall_world(4, 400.0, Fluid::water()).unwrap()
     })
 }
 
@@ -156,13 +142,10 @@ fn a_jet_on_a_wall_gives_identical_bits_on_one_and_two_threads() {
     let (a, b) = (jet_on_wall(1), jet_on_wall(2));
     let bits = |w: &World| -> Vec<u64> {
         let p = w.particles();
-        p.pos
-            .iter()
-            .chain(&p.vel)
-            .flat_map(|x| [x.x.to_bits(), x.y.to_bits()])
-            .chain(p.rho.iter().map(|r| r.to_bits()))
+        common::flow_bits(w)
+            .into_iter()
             .chain(p.id.iter().map(|&i| i as u64))
-            .chain([w.dt().to_bits(), w.wall_force(0).y.to_bits()])
+            .chain([w.wall_force(0).y.to_bits()])
             .collect()
     };
     assert_eq!(bits(&a), bits(&b));

@@ -5,7 +5,6 @@
 use super::{CaseReport, Chart, Row, Series};
 use crate::error::SimError;
 use crate::fluid::Fluid;
-use crate::kernel::KernelKind;
 use crate::math::Vector;
 use crate::particles::KINEMATIC;
 use crate::world::{Settings, World};
@@ -55,15 +54,7 @@ pub fn tank(n: usize, width_n: usize) -> Result<World, SimError> {
         )));
     }
     let dx = HYDRO_H / n as f64;
-    let settings = Settings {
-        spacing_m: dx,
-        h_over_dx: 1.25,
-        kernel: KernelKind::CubicSpline,
-        cfl: 0.2,
-        gravity_m_s2: Vector::new(0.0, -HYDRO_G),
-        shepard_interval: 0,
-        ..Settings::default()
-    };
+    let settings = Settings::water_jet(dx, Vector::new(0.0, -HYDRO_G));
     let water = hydrostatic_water();
     let p_ref = |y: f64| water.density() * HYDRO_G * (HYDRO_H - y).max(0.0);
     let mut world = World::new(settings).map_err(|e| fail(e.to_string()))?;

@@ -6,7 +6,6 @@
 use super::{CaseReport, Chart, Row, Series};
 use crate::error::SimError;
 use crate::fluid::Fluid;
-use crate::kernel::KernelKind;
 use crate::math::Vector;
 use crate::world::{Nozzle, Settings, World};
 use crate::Motion;
@@ -62,15 +61,7 @@ pub fn jet_wall_world(n: usize, speed: f64, water: Fluid) -> Result<World, SimEr
         return Err(fail(format!("jet_wall: n = {n}; needs an even n >= 2")));
     }
     let dx = JET_B / n as f64;
-    let settings = Settings {
-        spacing_m: dx,
-        h_over_dx: 1.25,
-        kernel: KernelKind::CubicSpline,
-        cfl: 0.2,
-        gravity_m_s2: Vector::zeros(),
-        shepard_interval: 0,
-        ..Settings::default()
-    };
+    let settings = Settings::water_jet(dx, Vector::zeros());
     let mut world = World::new(settings).map_err(|e| fail(e.to_string()))?;
     let half_out = OUTFLOW_HALF_WIDTH_B * JET_B;
     // The wall reaches a kernel support past the outflow, so a sheet keeps its wall until it

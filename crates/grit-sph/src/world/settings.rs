@@ -68,6 +68,20 @@ impl Default for Settings {
 }
 
 impl Settings {
+    /// The water-jet paper's numerics (seed 002, docs/jet.md): cubic spline at h = 1.25 Δx,
+    /// Courant number C_F = 0.2, no density filter, at spacing `spacing_m` under `gravity_m_s2`.
+    pub fn water_jet(spacing_m: f64, gravity_m_s2: Vector) -> Settings {
+        Settings {
+            spacing_m,
+            h_over_dx: 1.25,
+            kernel: KernelKind::CubicSpline,
+            cfl: 0.2,
+            gravity_m_s2,
+            shepard_interval: 0,
+            ..Settings::default()
+        }
+    }
+
     /// Checks that every setting is usable; the error names the field.
     pub fn validate(&self) -> Result<(), InputError> {
         let pos = |f: &str, v: f64| InputError::require_positive(f, v);
