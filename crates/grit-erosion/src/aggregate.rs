@@ -154,6 +154,12 @@ pub struct CellResult {
 }
 
 impl CellResult {
+    /// Whether `other` is the same cell (angle, shape and other swept values), from another
+    /// results file.
+    pub fn same_cell(&self, other: &CellResult) -> bool {
+        self.angle_deg == other.angle_deg && self.shape == other.shape && self.swept == other.swept
+    }
+
     /// The cell's name in messages: angle, shape and any other swept values.
     pub fn label(&self) -> String {
         let mut label = format!("{}° {}", self.angle_deg, self.shape);

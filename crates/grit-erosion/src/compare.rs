@@ -226,20 +226,17 @@ pub fn on_window(
 /// sampling error is the yardstick).
 pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell> {
     let mut out: Vec<RepeatedCell> = Vec::new();
-    let mut seen: Vec<(String, f64, &std::collections::BTreeMap<String, f64>)> = Vec::new();
+    let mut seen: Vec<&CellResult> = Vec::new();
     for (k, (_, first)) in files.iter().enumerate() {
         for c in &first.cells {
-            let key = (c.shape.clone(), c.angle_deg, &c.swept);
-            if seen.contains(&key) {
+            if seen.iter().any(|s| s.same_cell(c)) {
                 continue;
             }
-            seen.push(key);
+            seen.push(c);
             let rows: Vec<RepeatRow> = files[k..]
                 .iter()
                 .filter_map(|(name, r)| {
-                    let same = r.cells.iter().find(|d| {
-                        d.shape == c.shape && d.angle_deg == c.angle_deg && d.swept == c.swept
-                    })?;
+                    let same = r.cells.iter().find(|d| d.same_cell(c))?;
                     let spec = r.spec.as_ref();
                     let spacing_m = spec_number(spec, &["spacing_m"]);
                     let dg = spec_number(spec, &["grain", "diameter_m"]);

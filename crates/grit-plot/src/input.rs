@@ -119,9 +119,7 @@ pub fn merge(inputs: Vec<(String, PlotInput)>) -> Result<(PlotInput, Vec<String>
         }
         let mut new_index = Vec::with_capacity(input.results.cells.len());
         for c in input.results.cells {
-            let same = merged.results.cells.iter().position(|m| {
-                m.angle_deg == c.angle_deg && m.shape == c.shape && m.swept == c.swept
-            });
+            let same = merged.results.cells.iter().position(|m| m.same_cell(&c));
             match same {
                 Some(k) => {
                     notes.push(format!(

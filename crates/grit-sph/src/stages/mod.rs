@@ -141,6 +141,11 @@ impl BodyConst {
     }
 }
 
+/// Whether any body is a fluid: solid-only scenes skip every fluid pass.
+pub(crate) fn any_fluid(bc: &[BodyConst]) -> bool {
+    bc.iter().any(|c| c.fluid.is_some())
+}
+
 /// The constants of each body, by body index (all zero and not deformable for a rigid body;
 /// a fluid body has only its `fluid` constants).
 pub(crate) fn body_consts(bodies: &[Body]) -> Vec<BodyConst> {

@@ -27,7 +27,7 @@ pub(crate) fn stable_dt(
     if smax > 0.0 {
         dt = dt.min(settings.cfl * h / smax);
     }
-    if bc.iter().any(|c| c.fluid.is_some()) {
+    if super::any_fluid(bc) {
         dt = dt.min(super::fluid_dt(p, bc, h, settings.cfl));
     }
     for c in contacts.iter().filter(|_| settings.contact_limits_dt) {

@@ -193,8 +193,8 @@ impl World {
             .unwrap_or_else(|| stages::body_consts(&self.bodies))
     }
 
-    /// Computes the bodies' constants once and keeps them until a body changes.
-    fn keep_body_consts(&mut self) {
+    /// The bodies' constants, computed once and kept until a body changes.
+    fn kept_body_consts(&mut self) -> Vec<BodyConst> {
         if self
             .consts
             .as_ref()
@@ -202,6 +202,7 @@ impl World {
         {
             self.consts = Some(stages::body_consts(&self.bodies));
         }
+        self.body_consts()
     }
 
     /// Reach of the neighbour lists: the kernel support plus the Verlet skin.
@@ -270,8 +271,7 @@ impl World {
         }
         let dt = self.dt;
         let n = self.particles.len();
-        self.keep_body_consts();
-        let bc = self.body_consts();
+        let bc = self.kept_body_consts();
 
         let mut timers = std::mem::take(&mut self.timers);
         if self.needs_rebuild() {
@@ -304,8 +304,7 @@ impl World {
             self.dt = self.compute_dt();
         }
         let dt = self.dt;
-        self.keep_body_consts();
-        let bc = self.body_consts();
+        let bc = self.kept_body_consts();
         let ready = self.nbrs_valid && self.scratch.pairs.count.len() == self.particles.len();
         if stage != Stage::Neighbours && !ready {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
@@ -392,8 +391,7 @@ impl World {
     /// Runs the configured density filter now (eq. 12, or its MLS form) and books the change
     /// of elastic energy as the filter's work; `step` calls it every `shepard_interval` steps.
     pub fn filter_density(&mut self) {
-        self.keep_body_consts();
-        let bc = self.body_consts();
+        let bc = self.kept_body_consts();
         self.filter_density_with(&bc);
     }
 
@@ -444,7 +442,7 @@ impl World {
             dt,
         );
         self.work.plastic -= plastic_work;
-        if bc.iter().any(|c| c.fluid.is_some()) {
+        if stages::any_fluid(bc) {
             let s = SphView {
                 p: &self.particles,
                 nl: &self.nbrs.same,
@@ -479,7 +477,7 @@ impl World {
             &mut sc.pair_forces,
         );
         self.work.hourglass += hg;
-        if bc.iter().any(|c| c.fluid.is_some()) {
+        if stages::any_fluid(bc) {
             let g = self.settings.gravity_m_s2;
             stages::fluid_accelerations(s, &self.nbrs.half, &sc.pairs, g, &mut sc.acc);
             stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_force);
