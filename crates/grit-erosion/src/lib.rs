@@ -9,6 +9,7 @@ pub mod campaign;
 pub mod compare;
 pub mod fits;
 pub mod impact;
+pub mod jet;
 pub mod sample;
 pub mod shapes;
 pub mod steady;

@@ -136,10 +136,7 @@ impl Sample {
     /// Two uniform numbers in [0, 1) for impact `k` (0-based): a ChaCha stream per impact, so
     /// impact k's grain does not depend on how earlier impacts went or where a run resumed.
     fn draws(&self, k: u32) -> (f64, f64) {
-        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
-        rng.set_stream(k as u64);
-        let unit = |x: u64| (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-        (unit(rng.next_u64()), unit(rng.next_u64()))
+        stream_draws(self.seed, k as u64)
     }
 
     /// The grain the next impact will fire (its random orientation and aim point).
@@ -252,6 +249,15 @@ impl Sample {
             last_particles: 0,
         })
     }
+}
+
+/// Two uniform numbers in [0, 1) from ChaCha8 stream `k` of `seed`: draw k of a run does not
+/// depend on the draws before it, so a resumed run draws what an unbroken one would.
+pub(crate) fn stream_draws(seed: u64, k: u64) -> (f64, f64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(k);
+    let unit = |x: u64| (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+    (unit(rng.next_u64()), unit(rng.next_u64()))
 }
 
 #[cfg(test)]

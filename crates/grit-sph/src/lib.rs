@@ -37,6 +37,7 @@ pub use math::{Matrix, Vector};
 pub use particles::Particles;
 pub use timers::{Stage, Timers};
 pub use world::{
-    CeilingPass, DensityFilter, Energy, Inflow, Nozzle, NumericalWork, Outflow, Settings, World,
+    Abrasives, CeilingPass, DensityFilter, Energy, GrainOutflow, Inflow, Nozzle, NumericalWork,
+    Outflow, PenaltyParams, Settings, World,
 };
 pub mod verification;

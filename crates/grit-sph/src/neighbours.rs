@@ -236,12 +236,18 @@ pub(crate) struct WorldLists {
     pub half: HalfIndex,
     /// For contact pair c, the primary boundary particles each secondary particle can touch.
     pub contact: Vec<ContactLists>,
+    /// Fluid–solid pairs (docs/jet.md#water-on-the-target): each fluid particle lists the
+    /// deformable particles within reach and each deformable particle the fluid ones, so both
+    /// sides gather their pairs in their own row's order. Empty rows without a fluid and a solid.
+    pub cross: NeighbourLists,
 }
 
 impl WorldLists {
-    /// Number of stored pairs (each direction counted), same-body and contact.
+    /// Number of stored pairs (each direction counted), same-body, contact and fluid–solid.
     pub fn pairs(&self) -> usize {
-        self.same.pairs() + self.contact.iter().map(|c| c.rows.pairs()).sum::<usize>()
+        self.same.pairs()
+            + self.contact.iter().map(|c| c.rows.pairs()).sum::<usize>()
+            + self.cross.pairs()
     }
 }
 
@@ -340,7 +346,30 @@ pub(crate) fn build_for_bodies(
         same,
         half,
         contact,
+        cross: cross_lists(p, bodies, radius),
     }
+}
+
+/// The fluid–solid rows of [`WorldLists::cross`]: every pair of a fluid and a deformable
+/// particle within `radius`, listed from both ends.
+fn cross_lists(p: &Particles, bodies: &[Body], radius: f64) -> NeighbourLists {
+    let n = p.len();
+    let fluid: Vec<bool> = bodies.iter().map(|b| b.fluid().is_some()).collect();
+    let solid: Vec<bool> = bodies.iter().map(|b| b.material().is_some()).collect();
+    if !(fluid.iter().any(|&f| f) && solid.iter().any(|&s| s)) {
+        return NeighbourLists {
+            start: vec![0; n + 1],
+            ..NeighbourLists::default()
+        };
+    }
+    let body = &p.body;
+    let either: Vec<bool> = (0..n)
+        .map(|i| fluid[body[i] as usize] || solid[body[i] as usize])
+        .collect();
+    build(&p.pos, &either, &either, radius, |i, j| {
+        let (bi, bj) = (body[i] as usize, body[j] as usize);
+        (fluid[bi] && solid[bj]) || (solid[bi] && fluid[bj])
+    })
 }
 
 /// The same-body pairs counted once each: pair (i, j) with i < j is kept in i's row, and both

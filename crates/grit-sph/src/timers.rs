@@ -18,7 +18,8 @@ pub enum Stage {
     Stress,
     /// Stress divergence and hourglass forces (eqs. 6, 16).
     Forces,
-    /// Contact detection and forces (eqs. 21–29).
+    /// Contact detection and forces (eqs. 21–29), and the abrasive grains' coupling, penalty
+    /// contact and DEM sub-steps (the AWJ paper eqs. 1, 12–14, 42–50).
     Contact,
     /// Rigid-body force, torque and motion (eq. 17).
     Rigid,

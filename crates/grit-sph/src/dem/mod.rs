@@ -382,22 +382,39 @@ impl Dem {
     /// from the current state plus gravity plus `external[i]` (a coupling force, N; empty for
     /// none) kick the velocities, which then move the grains.
     pub fn step(&mut self, dt: f64, external: &[Vector]) -> Result<(), InputError> {
+        self.step_loaded(dt, external, &[])
+    }
+
+    /// [`Dem::step`] with external torques too (`external_torque[i]` about grain i's centre,
+    /// N·m; empty for none): the penalty contact with a target acts at the grain's surface
+    /// (the AWJ paper eq. 14).
+    pub fn step_loaded(
+        &mut self,
+        dt: f64,
+        external: &[Vector],
+        external_torque: &[f64],
+    ) -> Result<(), InputError> {
         InputError::require_positive("dt", dt)?;
-        if !external.is_empty() && external.len() != self.grains.len() {
-            return Err(InputError::new(
-                "external",
-                format!(
-                    "must be empty or hold one force per grain ({}), got {}",
-                    self.grains.len(),
-                    external.len()
-                ),
-            ));
+        for (name, len, what) in [
+            ("external", external.len(), "force"),
+            ("external_torque", external_torque.len(), "torque"),
+        ] {
+            if len != 0 && len != self.grains.len() {
+                return Err(InputError::new(
+                    name,
+                    format!(
+                        "must be empty or hold one {what} per grain ({}), got {len}",
+                        self.grains.len()
+                    ),
+                ));
+            }
         }
         self.contact_forces(dt);
         for (i, g) in self.grains.iter_mut().enumerate() {
             let f_ext = external.get(i).copied().unwrap_or_else(Vector::zeros);
+            let t_ext = external_torque.get(i).copied().unwrap_or(0.0);
             g.vel += (self.force[i] + f_ext) / g.mass_kg * dt + self.gravity * dt;
-            g.omega += self.torque[i] / g.inertia_kg_m2 * dt;
+            g.omega += (self.torque[i] + t_ext) / g.inertia_kg_m2 * dt;
             g.pos += g.vel * dt;
             g.angle += g.omega * dt;
         }

@@ -1,10 +1,8 @@
-//! The fluid's parts of the step (the AWJ paper eqs. 22–27, docs/jet.md#water-in-the-engine):
+//! The fluid's parts of the step (the AWJ paper eqs. 20–27, docs/jet.md#water-in-the-engine):
 //! the continuity rate of the porosity-weighted density ρ̄ and its update, then the
 //! accelerations from the updated density, both summed over the same-body pairs the kernel
-//! sums cached, and the fluid's time-step limits.
-//!
-//! Until grains join the world the porosity is ε = 1 everywhere, so ρ̄ is the fluid's own
-//! density; the sums already carry ρ̄ where the paper does.
+//! sums cached, and the fluid's time-step limits. The porosity ε of each particle comes from
+//! the grains (`stages::abrasives`), 1 where there are none.
 
 use rayon::prelude::*;
 
@@ -15,10 +13,6 @@ use crate::fluid::{self, ArtificialViscosity, Fluid};
 use crate::math::Vector;
 use crate::neighbours::HalfIndex;
 use crate::particles::{Particles, KINEMATIC};
-
-/// The porosity the fluid stage uses until grains join the world (AWJ paper eq. 20 with no
-/// grains).
-const NO_GRAINS_POROSITY: f64 = 1.0;
 
 /// The constants of a fluid body the stages read, copied out of its [`Fluid`].
 #[derive(Debug, Clone, Copy)]
@@ -52,6 +46,18 @@ impl FluidConst {
         self.eos
             .pressure((rho_bar / porosity).min(self.rho_cap), 0.0)
             .max(self.min_pressure)
+    }
+
+    /// The lowest gauge pressure the fluid sustains (its cavitation cut, Pa).
+    #[inline]
+    pub fn min_pressure(&self) -> f64 {
+        self.min_pressure
+    }
+
+    /// Its artificial-viscosity coefficients (eq. 26).
+    #[inline]
+    pub fn av(&self) -> ArtificialViscosity {
+        self.av
     }
 
     /// `Fluid::sound_speed` (the cold curve's √(dp/dρ) at ρ = ρ̄/ε), capped like the pressure.
@@ -101,53 +107,75 @@ pub(crate) fn fluid_continuity(
     }));
 }
 
+/// Pressure and sound speed of every particle once per step, read by each of its pairs: a fluid
+/// particle's from its EOS at ρ̄/ε (eq. 24, `porosity` ε per particle), a deformable one's from
+/// its material's pressure law and sound speed (for the fluid–solid pairs), zero otherwise.
+pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst], porosity: &[f64]) -> Vec<(f64, f64)> {
+    (0..p.len())
+        .into_par_iter()
+        .par_tasks()
+        .map(|i| {
+            let c = &bc[p.body[i] as usize];
+            match c.fluid {
+                Some(f) => (
+                    f.pressure(p.rho[i], porosity[i]),
+                    f.sound_speed(p.rho[i], porosity[i]),
+                ),
+                None if c.deformable => (c.pressure(p.rho[i], p.rho0[i]), c.sound),
+                None => (0.0, 0.0),
+            }
+        })
+        .collect()
+}
+
 /// Accelerations of the fluid particles into `accel`: pressure gradient (eq. 23) with the
-/// pressure of eq. 24, Shao–Lo laminar viscosity (eq. 25), Monaghan artificial viscosity
-/// (eqs. 26–27) and gravity `g`. Kinematic fluid particles (the walls) get the pair terms
-/// alone, which the integration ignores and [`wall_forces`] sums; the other bodies' particles
-/// keep what `accel` holds. Reads the densities after this step's continuity update, so density
-/// and velocity advance as a symplectic pair.
+/// pressures of `state` ([`particle_state`]), Shao–Lo laminar viscosity (eq. 25), Monaghan
+/// artificial viscosity (eqs. 26–27) and gravity `g`; `theta` gets the pressure and laminar
+/// parts alone, θ_a of eq. 43, which the coupling interpolates at the grains (0 for other
+/// particles). Kinematic fluid particles (the walls) get the pair terms alone, which the
+/// integration ignores and [`wall_forces`] sums; the other bodies' particles keep what `accel`
+/// holds. Reads the densities after this step's continuity update, so density and velocity
+/// advance as a symplectic pair.
 pub(crate) fn fluid_accelerations(
     s: SphView<'_>,
     hi: &HalfIndex,
     cache: &PairCache,
+    state: &[(f64, f64)],
     g: Vector,
     accel: &mut [Vector],
+    theta: &mut Vec<Vector>,
 ) {
     let SphView { p, k, bc, .. } = s;
     let h = k.h;
     let fc = |i: usize| bc[p.body[i] as usize].fluid;
-    // Pressure and sound speed once per particle, read by each of its pairs.
-    let state: Vec<(f64, f64)> = (0..p.len())
-        .into_par_iter()
-        .par_tasks()
-        .map(|i| {
-            fc(i).map_or((0.0, 0.0), |f| {
-                (
-                    f.pressure(p.rho[i], NO_GRAINS_POROSITY),
-                    f.sound_speed(p.rho[i], NO_GRAINS_POROSITY),
-                )
-            })
-        })
-        .collect();
+    theta.clear();
+    theta.resize(p.len(), Vector::zeros());
     accel
         .par_iter_mut()
+        .zip(theta.par_iter_mut())
         .par_tasks()
         .enumerate()
-        .for_each(|(i, acc)| {
+        .for_each(|(i, (acc, th))| {
             let Some(f) = fc(i) else { return };
             let (rho_a, (p_a, c_a), v_a) = (p.rho[i], state[i], p.vel[i]);
-            let mut a = Vector::zeros();
+            // θ beside the total, each summed in the pairs' order: the total keeps the bits it
+            // had before θ was split out.
+            let (mut a, mut t) = (Vector::zeros(), Vector::zeros());
             for (j, pair) in pairs_of(s, hi, cache, i) {
                 let (m_b, rho_b, (p_b, c_b)) = (p.mass[j], p.rho[j], state[j]);
                 let grad = pair.xij * pair.dw_r;
                 let v_ab = v_a - p.vel[j];
-                a += fluid::pressure_acceleration(m_b, p_a, rho_a, p_b, rho_b, grad);
-                a += fluid::shao_lo_acceleration(f.nu, m_b, rho_a, rho_b, pair.xij, v_ab, grad, h);
+                let pressure = fluid::pressure_acceleration(m_b, p_a, rho_a, p_b, rho_b, grad);
+                let laminar =
+                    fluid::shao_lo_acceleration(f.nu, m_b, rho_a, rho_b, pair.xij, v_ab, grad, h);
+                a += pressure;
+                a += laminar;
+                t += pressure + laminar;
                 let pi =
                     f.av.pi_ab(pair.xij, v_ab, 0.5 * (c_a + c_b), 0.5 * (rho_a + rho_b), h);
                 a += fluid::artificial_viscosity_acceleration(m_b, pi, grad);
             }
+            *th = t;
             *acc = if p.flags[i] & KINEMATIC != 0 {
                 a
             } else {
@@ -192,15 +220,21 @@ pub(crate) fn fluid_density(p: &mut Particles, bc: &[BodyConst], drho: &[f64], d
 }
 
 /// The smallest time step the fluid particles allow (s; ∞ without any): the CFL limit
-/// `cfl` · h / max(c + |v|) with c the EOS's sound speed at each particle's density, and the
+/// `cfl` · h / max(c + |v|) with c the EOS's sound speed at each particle's ρ̄/ε, and the
 /// viscous diffusion limit 0.125 h²/ν of an explicit step (Morris, Fox & Zhu 1997).
-pub(crate) fn fluid_dt(p: &Particles, bc: &[BodyConst], h: f64, cfl: f64) -> f64 {
+pub(crate) fn fluid_dt(
+    p: &Particles,
+    bc: &[BodyConst],
+    porosity: &[f64],
+    h: f64,
+    cfl: f64,
+) -> f64 {
     let fc = |i: usize| bc[p.body[i] as usize].fluid;
     let smax = (0..p.len())
         .into_par_iter()
         .par_tasks()
         .filter_map(|i| {
-            fc(i).map(|f| f.sound_speed(p.rho[i], NO_GRAINS_POROSITY) + p.vel[i].norm())
+            fc(i).map(|f| f.sound_speed(p.rho[i], porosity[i]) + p.vel[i].norm())
         })
         .reduce(|| 0.0, f64::max);
     let nu_max = bc

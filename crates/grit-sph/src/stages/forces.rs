@@ -1,5 +1,6 @@
 //! The forces: the stress divergence with the normalised kernel gradient (eqs. 6 and 9), the
-//! hourglass force (eq. 16) and gravity.
+//! hourglass force (eq. 16), the optional artificial viscosity of the water-jet paper's solid
+//! phase (its eq. 26) and gravity.
 
 use rayon::prelude::*;
 
@@ -27,8 +28,8 @@ pub(crate) struct PairForce {
 }
 
 /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9, with the
-/// Shepard sums `sh`), the hourglass force (eq. 16, against the velocity gradients `gv`) and
-/// gravity, into `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes
+/// Shepard sums `sh`), the hourglass force (eq. 16, against the velocity gradients `gv`),
+/// Monaghan's Π_ij where `settings.solid_viscosity` asks for it, and gravity, into `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes
 /// after the stress stage. Each pair's shared terms are evaluated once (`hi`), and each particle
 /// gathers its pairs in its own row's order.
 #[allow(clippy::too_many_arguments)]
@@ -46,6 +47,7 @@ pub(crate) fn forces(
 ) -> f64 {
     let SphView { p, nl, k, bc } = s;
     let alpha = settings.hourglass;
+    let av = settings.solid_viscosity;
     let g = settings.gravity_m_s2;
     let h = k.h;
     // σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
@@ -102,7 +104,11 @@ pub(crate) fn forces(
                     near_ref,
                     ..
                 } = *pair;
-                let stress = (sig[i] + sig[j]) * (xij * dw_r);
+                let mut stress = (sig[i] + sig[j]) * (xij * dw_r);
+                if let Some(av) = &av {
+                    let (vij, rho_mean) = (p.vel[i] - p.vel[j], 0.5 * (p.rho[i] + p.rho[j]));
+                    stress -= xij * (dw_r * av.pi_ab(xij, vij, c.sound, rho_mean, h));
+                }
                 let mut hourglass = 0.0;
                 if hourglass_on(pair) {
                     // Viscous part: velocity error against the mean velocity gradient.

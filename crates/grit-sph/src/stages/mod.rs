@@ -2,28 +2,35 @@
 //! functions: each borrows what it reads, writes into the outputs it is given and returns the
 //! rest. `World::step` is the one place that runs them, in order.
 
+mod abrasives;
 mod ceiling;
 mod contact;
 mod density_filter;
 mod fluid;
 mod forces;
 mod integrate;
+mod interface;
 mod kernel_sums;
 mod pairs;
 mod rigid;
 mod stress;
 mod time_step;
 
+pub(crate) use abrasives::{
+    advance, coupling_forces, fresh_loads, grain_porosity, penalty, porosity_at, CouplingFrame,
+    GrainLoads,
+};
 pub(crate) use ceiling::ceiling;
 pub use ceiling::CeilingPass;
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
 use fluid::fluid_dt;
 pub(crate) use fluid::{
-    fluid_accelerations, fluid_continuity, fluid_density, wall_forces, FluidConst,
+    fluid_accelerations, fluid_continuity, fluid_density, particle_state, wall_forces, FluidConst,
 };
 pub(crate) use forces::{forces, PairForce};
 pub(crate) use integrate::{integrate, Blowup};
+pub(crate) use interface::{interface_continuity, interface_forces};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};
 pub(crate) use pairs::PairCache;
 pub(crate) use rigid::rigid;

@@ -101,7 +101,8 @@ impl World {
     /// Adds a fluid body (the AWJ paper eqs. 21–27) of particles at `points`, each standing for
     /// `volume_m2` (area per unit depth) at gauge pressure `pressure_pa`: its density is the
     /// EOS's at that pressure (`Fluid::density_at`) and its mass that density times the volume.
-    /// Walls that hold it are its own particles made kinematic (`set_kinematic`).
+    /// Walls that hold it are its own particles made kinematic (`set_kinematic`). It may start
+    /// empty when an inflow (`add_inflow`) is to fill it.
     pub fn add_fluid(
         &mut self,
         name: &str,
@@ -112,12 +113,6 @@ impl World {
         velocity_m_s: Vector,
     ) -> Result<usize, InputError> {
         fluid.validate(&format!("{name}.fluid"))?;
-        if points.is_empty() {
-            return Err(InputError::new(
-                format!("{name}.points"),
-                "a body needs at least one particle",
-            ));
-        }
         for (field, len) in [
             ("volume_m2", volume_m2.len()),
             ("pressure_pa", pressure_pa.len()),

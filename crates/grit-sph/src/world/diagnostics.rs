@@ -10,7 +10,8 @@ use crate::particles::dev_contract;
 /// Energy of the world and what the numerics have added or taken (J/m, per unit depth).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Energy {
-    /// Kinetic energy of deformable and fluid particles and rigid bodies.
+    /// Kinetic energy of deformable and fluid particles, rigid bodies and abrasive grains (a
+    /// grain's per metre of depth is its disc's, `plane_mass`).
     pub kinetic: f64,
     /// Elastic strain energy: V (p²/2K + s:s/4G) summed over deformable particles.
     pub elastic: f64,
@@ -76,6 +77,12 @@ impl World {
                 }
             }
         }
+        for g in self.abrasives.iter().flat_map(|a| &a.dem.grains) {
+            let m = super::plane_mass(g);
+            let inertia = g.inertia_kg_m2 / g.mass_kg * m;
+            e.kinetic += 0.5 * m * g.vel.norm_squared() + 0.5 * inertia * g.omega * g.omega;
+            e.gravity -= m * self.settings.gravity_m_s2.dot(&g.pos);
+        }
         for c in &self.contacts {
             for (i, &pen) in c.penetration.iter().enumerate() {
                 if pen > 0.0 {
@@ -86,8 +93,8 @@ impl World {
         e
     }
 
-    /// Total linear momentum of deformable and fluid particles and free rigid bodies (kg·m/s
-    /// per m).
+    /// Total linear momentum of deformable and fluid particles, free rigid bodies and abrasive
+    /// grains (kg·m/s per m; a grain's is its disc's, `Abrasives::plane_momentum`).
     pub fn momentum(&self) -> Vector {
         let p = &self.particles;
         let mut m = Vector::zeros();
@@ -103,6 +110,9 @@ impl World {
                     m += r.velocity_m_s * r.mass_kg_m;
                 }
             }
+        }
+        for g in self.abrasives.iter().flat_map(|a| &a.dem.grains) {
+            m += super::Abrasives::plane_momentum(g);
         }
         m
     }

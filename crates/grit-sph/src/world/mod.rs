@@ -5,11 +5,13 @@
 //! module hands the world's arrays. Building a world is in `build`, its settings in `settings`,
 //! what it reports about itself in `diagnostics`.
 
+mod abrasives;
 mod build;
 mod diagnostics;
 mod flow;
 mod settings;
 
+pub use abrasives::{plane_mass, Abrasives, GrainOutflow, PenaltyParams};
 pub use crate::stages::{CeilingPass, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
@@ -49,6 +51,16 @@ struct Scratch {
     drho: Vec<f64>,
     /// Per body, the force the fluid's pair terms put on its kinematic particles.
     wall_force: Vec<Vector>,
+    /// Porosity ε of every particle (eq. 20; 1 away from grains), for this step's fluid EOS.
+    porosity: Vec<f64>,
+    /// Pressure and sound speed of every particle this step (`stages::particle_state`).
+    state: Vec<(f64, f64)>,
+    /// θ_a of the AWJ paper eq. 43 per particle: the fluid's pressure and laminar acceleration.
+    theta: Vec<Vector>,
+    /// The grains' pairs with the fluid at the step's start.
+    frame: stages::CouplingFrame,
+    /// Loads on the grains from the fluid and the target.
+    loads: stages::GrainLoads,
 }
 
 /// A 2D SPH scene: bodies, their particles, contact pairs, time.
@@ -69,6 +81,9 @@ pub struct World {
     /// Inflows and outflows of fluid bodies; absent from the JSON of a world without any.
     #[serde(default, skip_serializing_if = "flow::Flow::is_empty")]
     flow: flow::Flow,
+    /// Abrasive grains and their coupling; absent from the JSON of a world without them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    abrasives: Option<Abrasives>,
     #[serde(skip)]
     nbrs: WorldLists,
     #[serde(skip)]
@@ -102,6 +117,7 @@ impl World {
             work: NumericalWork::default(),
             x_build: Vec::new(),
             flow: flow::Flow::default(),
+            abrasives: None,
             nbrs: WorldLists::default(),
             nbrs_valid: false,
             scratch: Scratch::default(),
@@ -236,13 +252,45 @@ impl World {
     /// contact springs' period.
     fn compute_dt(&self) -> f64 {
         let bc = self.body_consts();
+        let mut porosity = Vec::new();
+        if stages::any_fluid(&bc) {
+            if self.porosity_in_eos() {
+                self.porosity_into(&mut porosity);
+            } else {
+                porosity.resize(self.particles.len(), 1.0);
+            }
+        }
         stages::stable_dt(
             &self.particles,
             &bc,
+            &porosity,
             self.kernel.h,
             &self.settings,
             &self.contacts,
         )
+    }
+
+    /// Whether the fluid's EOS reads ρ̄/ε (`CouplingParams::porosity_in_eos`; true without
+    /// grains, where ε = 1).
+    fn porosity_in_eos(&self) -> bool {
+        self.abrasives
+            .as_ref()
+            .is_none_or(|a| a.coupling.porosity_in_eos)
+    }
+
+    /// The porosity of every particle from the grains (eq. 20), 1 without any; returns the
+    /// frame the coupling forces reuse. A grain set that `set_abrasives` accepted always gives
+    /// pairs, so an error here is a bug.
+    fn porosity_into(&self, porosity: &mut Vec<f64>) -> stages::CouplingFrame {
+        match &self.abrasives {
+            Some(ab) => stages::grain_porosity(&self.particles, ab, porosity)
+                .expect("the grains and coupling were checked when set"),
+            None => {
+                porosity.clear();
+                porosity.resize(self.particles.len(), 1.0);
+                stages::CouplingFrame::default()
+            }
+        }
     }
 
     /// The time step the next `step` will take: CFL on the current state, and the contact
@@ -279,9 +327,18 @@ impl World {
         }
         // The rates are summed in the kernel sums' pass; their timer stays at zero in a step.
         timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
+        let fluid = stages::any_fluid(&bc);
+        if fluid {
+            let mut porosity = std::mem::take(&mut self.scratch.porosity);
+            self.scratch.frame = self.porosity_into(&mut porosity);
+            self.scratch.porosity = porosity;
+        }
         timers.time(Stage::Stress, || self.stress(&bc, dt));
         timers.time(Stage::Forces, || self.forces(&bc, dt));
-        let contact = timers.time(Stage::Contact, || self.contact(&bc, dt));
+        let contact = timers.time(Stage::Contact, || {
+            self.contact(&bc, dt)?;
+            self.grains(&bc, dt)
+        });
         timers.time(Stage::Rigid, || self.rigid(dt));
         let checked = timers.time(Stage::Integrate, || self.integrate(&bc, dt));
         self.timers = timers;
@@ -384,6 +441,7 @@ impl World {
             self.retain_particles(&keep);
         }
         self.flow_step(self.dt);
+        self.grain_outflow_step();
         self.dt = self.compute_dt();
         Ok(())
     }
@@ -451,11 +509,15 @@ impl World {
             };
             let sc = &mut self.scratch;
             stages::fluid_continuity(s, &self.nbrs.half, &sc.pairs, &mut sc.drho);
+            if self.nbrs.cross.pairs() > 0 {
+                stages::interface_continuity(s, &self.nbrs.cross, &mut sc.drho);
+            }
             stages::fluid_density(&mut self.particles, bc, &sc.drho, dt);
         }
     }
 
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
+        let in_eos = self.porosity_in_eos();
         let s = SphView {
             p: &self.particles,
             nl: &self.nbrs.same,
@@ -479,7 +541,21 @@ impl World {
         self.work.hourglass += hg;
         if stages::any_fluid(bc) {
             let g = self.settings.gravity_m_s2;
-            stages::fluid_accelerations(s, &self.nbrs.half, &sc.pairs, g, &mut sc.acc);
+            let ones;
+            let eos_porosity = if in_eos {
+                &sc.porosity
+            } else {
+                ones = vec![1.0; sc.porosity.len()];
+                &ones
+            };
+            sc.state = stages::particle_state(s.p, bc, eos_porosity);
+            let (hi, state) = (&self.nbrs.half, &sc.state);
+            stages::fluid_accelerations(s, hi, &sc.pairs, state, g, &mut sc.acc, &mut sc.theta);
+            if self.nbrs.cross.pairs() > 0 {
+                let av = self.settings.solid_viscosity;
+                let cross = &self.nbrs.cross;
+                stages::interface_forces(s, cross, state, av, &mut sc.acc, &mut sc.theta);
+            }
             stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_force);
         }
     }
@@ -519,6 +595,33 @@ impl World {
                 self.particles.id[i], self.bodies[c.secondary].name, self.bodies[c.primary].name, distance
             ),
         })
+    }
+
+    /// The grains' part of the step (`stages::abrasives`): coupling forces on grains and fluid,
+    /// the penalty contact with the deformable particles, then the grains' DEM sub-steps.
+    fn grains(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
+        let Some(ab) = self.abrasives.as_mut() else {
+            return Ok(());
+        };
+        let sc = &mut self.scratch;
+        stages::fresh_loads(ab, &mut sc.loads);
+        let err = |e: crate::error::InputError| SimError {
+            step: self.steps,
+            time_s: self.time,
+            what: format!("abrasives: {e}"),
+        };
+        if let Some(fb) = ab.fluid_body {
+            let fluid = self.bodies[fb].fluid().expect("checked by set_abrasives");
+            let p = &self.particles;
+            let (frame, eps, theta) = (&sc.frame, &sc.porosity, &sc.theta);
+            stages::coupling_forces(p, ab, fluid, frame, eps, theta, &mut sc.acc, &mut sc.loads)
+                .map_err(err)?;
+        }
+        let d_ini = self.settings.spacing_m;
+        let cf = &mut sc.contact_force;
+        stages::penalty(&self.particles, bc, ab, d_ini, dt, cf, &mut sc.loads);
+        ab.substeps = stages::advance(ab, dt, &sc.loads).map_err(err)?;
+        Ok(())
     }
 
     fn rigid(&mut self, dt: f64) {

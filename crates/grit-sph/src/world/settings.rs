@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::InputError;
+use crate::fluid::ArtificialViscosity;
 use crate::kernel::KernelKind;
 use crate::math::Vector;
 
@@ -41,6 +42,10 @@ pub struct Settings {
     /// Rigid bodies keep only their outline layer of particles: interior particles of a rigid body are never searched, touched or summed, and its mass
     /// and inertia come from the polygon, so dropping them changes no result.
     pub rigid_shell: bool,
+    /// Monaghan artificial viscosity of the deformable bodies' pairs (the AWJ paper eq. 26,
+    /// α = β = 1.0 in its solid phase); `None`, the impact scene's choice, adds none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solid_viscosity: Option<ArtificialViscosity>,
 }
 
 /// The largest Courant number `Settings` accepts.
@@ -63,13 +68,15 @@ impl Default for Settings {
             temperature_k: 293.0,
             contact_limits_dt: true,
             rigid_shell: false,
+            solid_viscosity: None,
         }
     }
 }
 
 impl Settings {
     /// The water-jet paper's numerics (seed 002, docs/jet.md): cubic spline at h = 1.25 Δx,
-    /// Courant number C_F = 0.2, no density filter, at spacing `spacing_m` under `gravity_m_s2`.
+    /// Courant number C_F = 0.2, no density filter, the solid phase's artificial viscosity
+    /// α = β = 1.0, at spacing `spacing_m` under `gravity_m_s2`.
     pub fn water_jet(spacing_m: f64, gravity_m_s2: Vector) -> Settings {
         Settings {
             spacing_m,
@@ -78,6 +85,7 @@ impl Settings {
             cfl: 0.2,
             gravity_m_s2,
             shepard_interval: 0,
+            solid_viscosity: Some(ArtificialViscosity::SOLID),
             ..Settings::default()
         }
     }
@@ -116,6 +124,9 @@ impl Settings {
         }
         if !(self.gravity_m_s2.x.is_finite() && self.gravity_m_s2.y.is_finite()) {
             return Err(InputError::new("gravity_m_s2", "must be finite"));
+        }
+        if let Some(av) = &self.solid_viscosity {
+            av.validate("solid_viscosity")?;
         }
         Ok(())
     }

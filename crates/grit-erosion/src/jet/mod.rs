@@ -1,0 +1,419 @@
+//! The abrasive water-jet scene (docs/jet.md; the AWJ paper, Sci. Rep. 14, 26115, 2024): a
+//! plane jet of water carrying DEM grains hits a metal target straight on, and the crater's
+//! depth Cd, width Cw, the mass loss and the largest plastic strain are sampled against time.
+//!
+//! A run advances in slices of simulated time (`slice_ms`), the farm's unit of progress: after
+//! each slice the crater is measured and the whole state can be checkpointed, so a killed run
+//! loses at most one slice.
+
+mod feed;
+mod scene;
+
+use grit_sph::crater::{self, CraterOptions, CraterSample};
+use grit_sph::dem::DemParams;
+use grit_sph::{InputError, PenaltyParams, SimError, Timers, World};
+use serde::{Deserialize, Serialize};
+
+use crate::campaign::MaterialSpec;
+pub use feed::{grain_spacing_m, Feed};
+pub use scene::{Layout, FIXED_SIDE_LAYERS};
+
+/// Everything that defines one jet run (one sample of a jet campaign's cell); SI units except
+/// where the name says. Defaults: the paper's copper case at 500 m/s on a reduced scene
+/// (docs/jet.md#the-scene).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct JetParams {
+    /// Target material: a preset name (`copper`, `al6061`, `aisi304`) or a full object.
+    pub material: MaterialSpec,
+    /// Jet speed v_jet at the nozzle (m/s).
+    pub velocity_m_s: f64,
+    /// Abrasive mass flow M (kg/s, the paper's eq. 55); 0 is a pure water jet.
+    pub mass_flow_kg_s: f64,
+    /// Simulated time T (ms).
+    pub time_ms: f64,
+    /// Length of one slice of simulated time, the unit of progress and checkpoints (ms).
+    pub slice_ms: f64,
+    /// Particle spacing Δx of water and target (m); the paper's d_ini is 50 µm.
+    pub spacing_m: f64,
+    /// Coupling radius over grain diameter, R_c/d (the paper settles on 2.0).
+    pub coupling_radius_d: f64,
+    /// Jet width d_jet (m; the paper's 1 mm); a whole number of spacings.
+    pub jet_width_m: f64,
+    /// Height of the nozzle's exit above the target's top (m; the paper gives none).
+    pub standoff_m: f64,
+    /// Target width (m).
+    pub target_width_m: f64,
+    /// Target depth (m).
+    pub target_depth_m: f64,
+    /// Grain diameter d (m; the paper's 0.2 mm garnet).
+    pub grain_diameter_m: f64,
+    /// Grain density (kg/m³; garnet 4120).
+    pub grain_density_kg_m3: f64,
+    /// The grains' contact constants (E, ν, restitution e, friction μ).
+    pub dem: DemParams,
+    /// The grain–target penalty contact (χ, μ).
+    pub penalty: PenaltyParams,
+}
+
+impl Default for JetParams {
+    fn default() -> Self {
+        JetParams {
+            material: MaterialSpec(grit_sph::Material::copper()),
+            velocity_m_s: 500.0,
+            mass_flow_kg_s: 0.02,
+            time_ms: 1.0,
+            slice_ms: 0.05,
+            spacing_m: 50e-6,
+            coupling_radius_d: 2.0,
+            jet_width_m: 1e-3,
+            standoff_m: 1e-3,
+            target_width_m: 6e-3,
+            target_depth_m: 2e-3,
+            grain_diameter_m: 0.2e-3,
+            grain_density_kg_m3: 4120.0,
+            dem: DemParams::default(),
+            penalty: PenaltyParams::default(),
+        }
+    }
+}
+
+/// Most slices one run may have: a guard against a typo that asks for years of steps.
+pub const MAX_SLICES: u32 = 100_000;
+
+impl JetParams {
+    /// Checks every field; the error names the field and the rule.
+    pub fn validate(&self) -> Result<(), InputError> {
+        self.material.0.validate()?;
+        for (name, v) in [
+            ("velocity_m_s", self.velocity_m_s),
+            ("time_ms", self.time_ms),
+            ("slice_ms", self.slice_ms),
+            ("spacing_m", self.spacing_m),
+            ("coupling_radius_d", self.coupling_radius_d),
+            ("jet_width_m", self.jet_width_m),
+            ("standoff_m", self.standoff_m),
+            ("target_width_m", self.target_width_m),
+            ("target_depth_m", self.target_depth_m),
+            ("grain_diameter_m", self.grain_diameter_m),
+            ("grain_density_kg_m3", self.grain_density_kg_m3),
+        ] {
+            InputError::require_positive(name, v)?;
+        }
+        if !(self.mass_flow_kg_s.is_finite() && self.mass_flow_kg_s >= 0.0) {
+            return Err(InputError::new(
+                "mass_flow_kg_s",
+                format!("must be a finite number >= 0, got {}", self.mass_flow_kg_s),
+            ));
+        }
+        self.dem.validate()?;
+        self.penalty.validate("penalty")?;
+        let cells = |len: f64| len / self.spacing_m;
+        let across = cells(self.jet_width_m);
+        if (across - across.round()).abs() > 1e-6 || across.round() < 2.0 {
+            return Err(InputError::new(
+                "jet_width_m",
+                format!(
+                    "must be a whole number (at least 2) of spacings {} m, got {} m ({across:.4} spacings)",
+                    self.spacing_m, self.jet_width_m
+                ),
+            ));
+        }
+        if self.target_width_m < self.jet_width_m + 2.0 * FIXED_SIDE_LAYERS as f64 * self.spacing_m
+        {
+            return Err(InputError::new(
+                "target_width_m",
+                format!(
+                    "must exceed the jet width {} m plus the fixed sides, got {} m",
+                    self.jet_width_m, self.target_width_m
+                ),
+            ));
+        }
+        if cells(self.target_depth_m) < 4.0 {
+            return Err(InputError::new(
+                "target_depth_m",
+                "must be at least 4 spacings deep",
+            ));
+        }
+        if self.grain_diameter_m >= self.jet_width_m {
+            return Err(InputError::new(
+                "grain_diameter_m",
+                format!(
+                    "must be smaller than the jet width {} m, got {} m",
+                    self.jet_width_m, self.grain_diameter_m
+                ),
+            ));
+        }
+        if self.slice_ms > self.time_ms {
+            return Err(InputError::new(
+                "slice_ms",
+                format!(
+                    "must not exceed time_ms ({}), got {}",
+                    self.time_ms, self.slice_ms
+                ),
+            ));
+        }
+        if self.slices() > MAX_SLICES {
+            return Err(InputError::new(
+                "slice_ms",
+                format!(
+                    "time_ms / slice_ms gives {} slices; at most {MAX_SLICES}",
+                    self.slices()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Number of slices: ⌈T / slice⌉ (the last may be shorter).
+    pub fn slices(&self) -> u32 {
+        let n = (self.time_ms / self.slice_ms - 1e-9).ceil();
+        if n.is_finite() && n >= 1.0 {
+            n.min(u32::MAX as f64) as u32
+        } else {
+            1
+        }
+    }
+
+    /// End time of slice `k` (0-based), s.
+    pub fn slice_end_s(&self, k: u32) -> f64 {
+        (((k + 1) as f64) * self.slice_ms).min(self.time_ms) * 1e-3
+    }
+}
+
+/// One finished slice: the crater and the run's state at its end.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JetSlice {
+    /// Slice number, from 1.
+    pub slice: u32,
+    /// Time, mass loss, Cd, Cw and the largest plastic strain at the slice's end.
+    pub sample: CraterSample,
+    /// Width of the crater at half its depth (m): ½ Cw for a V, → Cw for a U.
+    pub half_depth_width_m: f64,
+    /// The target's surface profile (x, y) in m, one point per column, left to right.
+    pub profile: Vec<[f64; 2]>,
+    /// Engine steps taken in the slice.
+    pub steps: u64,
+    /// Particles (water and target) at the slice's end.
+    pub particles: usize,
+    /// Grains in the scene at the slice's end.
+    pub grains: usize,
+    /// Grains fed into the jet so far.
+    pub grains_fed: u64,
+    /// Wall-clock seconds the slice took.
+    pub wall_s: f64,
+}
+
+/// Why a jet run could not go on.
+#[derive(Debug, thiserror::Error)]
+pub enum JetError {
+    /// The parameters are not usable.
+    #[error("{0}")]
+    Input(#[from] InputError),
+    /// The simulation blew up.
+    #[error("simulation failed: {0}")]
+    Sim(#[from] SimError),
+    /// A checkpoint could not be read or belongs to another run.
+    #[error("checkpoint {0}")]
+    Checkpoint(String),
+}
+
+/// A jet run in progress: the world, the grain feed, and the slices done.
+#[derive(Debug, Clone)]
+pub struct JetRun {
+    params: JetParams,
+    seed: u64,
+    layout: Layout,
+    world: World,
+    feed: Feed,
+    slices: Vec<JetSlice>,
+}
+
+/// What a checkpoint holds; the world goes as JSON (its optional parts are skipped when
+/// absent, which only a self-describing format reads back).
+#[derive(Serialize, Deserialize)]
+struct Checkpoint {
+    version: u32,
+    params: JetParams,
+    seed: u64,
+    world: World,
+    feed: Feed,
+    slices: Vec<JetSlice>,
+}
+
+/// Version of the checkpoint layout; a build reads only its own.
+const CHECKPOINT_VERSION: u32 = 1;
+
+impl JetRun {
+    /// A fresh run of `params` whose grains are placed from `seed`.
+    pub fn new(params: JetParams, seed: u64) -> Result<JetRun, JetError> {
+        params.validate()?;
+        let (world, layout) = scene::build(&params)?;
+        let feed = Feed::new(&params);
+        Ok(JetRun {
+            params,
+            seed,
+            layout,
+            world,
+            feed,
+            slices: Vec::new(),
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &JetParams {
+        &self.params
+    }
+    /// The seed of the grain placement.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+    /// The world as it is now.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+    /// Where the scene's parts are.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+    /// Slices finished.
+    pub fn slices(&self) -> &[JetSlice] {
+        &self.slices
+    }
+    /// Slices finished so far.
+    pub fn slices_done(&self) -> u32 {
+        self.slices.len() as u32
+    }
+    /// Slices in the whole run.
+    pub fn slices_total(&self) -> u32 {
+        self.params.slices()
+    }
+    /// True when every slice is done.
+    pub fn finished(&self) -> bool {
+        self.slices_done() >= self.slices_total()
+    }
+    /// The engine's per-stage timers over the last slice.
+    pub fn timers(&self) -> &Timers {
+        self.world.timers()
+    }
+
+    /// Runs the next slice; returns it.
+    pub fn run_next_slice(&mut self) -> Result<&JetSlice, JetError> {
+        self.run_next_slice_observed(&|| false, None)?
+            .ok_or_else(|| JetError::Checkpoint("cancelled without a cancel request".into()))
+    }
+
+    /// Runs the next slice, calling `observe` after every step (snapshots, progress) and
+    /// giving up (`None`, state as at the slice's start is lost: resume from a checkpoint)
+    /// when `cancel` says so between steps.
+    pub fn run_next_slice_observed(
+        &mut self,
+        cancel: &dyn Fn() -> bool,
+        mut observe: Option<&mut dyn FnMut(&World)>,
+    ) -> Result<Option<&JetSlice>, JetError> {
+        let k = self.slices_done();
+        if k >= self.slices_total() {
+            return Err(JetError::Input(InputError::new(
+                "slice",
+                format!("the run has all its {k} slices"),
+            )));
+        }
+        let t_end = self.params.slice_end_s(k);
+        let t0 = std::time::Instant::now();
+        let steps0 = self.world.steps();
+        self.world.timers_mut().reset();
+        while self.world.time() < t_end {
+            if cancel() {
+                return Ok(None);
+            }
+            self.world.step()?;
+            self.feed
+                .release(&mut self.world, &self.params, &self.layout, self.seed)?;
+            if let Some(f) = observe.as_mut() {
+                f(&self.world);
+            }
+        }
+        let slice = self.measure(k + 1, self.world.steps() - steps0, t0.elapsed().as_secs_f64())?;
+        self.slices.push(slice);
+        Ok(self.slices.last())
+    }
+
+    /// The crater and state now, as slice `slice`.
+    fn measure(&self, slice: u32, steps: u64, wall_s: f64) -> Result<JetSlice, JetError> {
+        let w = &self.world;
+        let opts = CraterOptions::for_spacing(self.params.spacing_m);
+        let target = self.layout.target_body;
+        let removed = w.bodies()[target].removed_mass_kg_m;
+        let p = w.particles();
+        let sample = crater::sample(
+            w.time(),
+            p,
+            target as u32,
+            removed,
+            self.layout.surface_y_m,
+            opts,
+        )?;
+        let pos: Vec<_> = (0..p.len())
+            .filter(|&i| p.body[i] as usize == target)
+            .map(|i| p.pos[i])
+            .collect();
+        let c = crater::crater(&pos, self.layout.surface_y_m, opts)?;
+        Ok(JetSlice {
+            slice,
+            sample,
+            half_depth_width_m: c.half_depth_width_m,
+            profile: c.profile.iter().map(|x| [x.x, x.y]).collect(),
+            steps,
+            particles: p.len(),
+            grains: w.abrasives().map_or(0, |a| a.dem.grains.len()),
+            grains_fed: self.feed.fed(),
+            wall_s,
+        })
+    }
+
+    /// The state after the last finished slice, as bytes (JSON; floats kept bit for bit).
+    pub fn checkpoint(&self) -> Vec<u8> {
+        let c = Checkpoint {
+            version: CHECKPOINT_VERSION,
+            params: self.params.clone(),
+            seed: self.seed,
+            world: self.world.clone(),
+            feed: self.feed.clone(),
+            slices: self.slices.clone(),
+        };
+        serde_json::to_vec(&c).expect("a checkpoint always serialises")
+    }
+
+    /// Goes on from `checkpoint()` bytes; the parameters and seed must be the run's own.
+    pub fn resume(params: &JetParams, seed: u64, bytes: &[u8]) -> Result<JetRun, JetError> {
+        let run = JetRun::from_checkpoint(bytes)?;
+        if run.params != *params || run.seed != seed {
+            return Err(JetError::Checkpoint(
+                "belongs to another run (parameters or seed differ)".into(),
+            ));
+        }
+        Ok(run)
+    }
+
+    /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them.
+    pub fn from_checkpoint(bytes: &[u8]) -> Result<JetRun, JetError> {
+        let c: Checkpoint = serde_json::from_slice(bytes)
+            .map_err(|e| JetError::Checkpoint(format!("cannot decode: {e}")))?;
+        if c.version != CHECKPOINT_VERSION {
+            return Err(JetError::Checkpoint(format!(
+                "version {} but this build reads {CHECKPOINT_VERSION}",
+                c.version
+            )));
+        }
+        c.params.validate()?;
+        let layout = Layout::of(&c.params);
+        Ok(JetRun {
+            params: c.params,
+            seed: c.seed,
+            layout,
+            world: c.world,
+            feed: c.feed,
+            slices: c.slices,
+        })
+    }
+}
