@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use cli::{bench, campaign, plot, sample, serve, study};
+use cli::{bench, campaign, jet, plot, sample, serve, study};
 
 /// Solid particle erosion predicted by SPH impact simulations.
 #[derive(Parser)]
@@ -36,6 +36,12 @@ enum Command {
         after_help = "Example: grit sample --angle 45 --shape hexagon --impacts 70 --seed 1"
     )]
     Sample(sample::SampleArgs),
+    /// Run one abrasive water jet on a metal target (the AWJ paper's scene): crater depth and
+    /// width, mass loss and plastic strain against time.
+    #[command(
+        after_help = "Example: grit jet --material copper --velocity-m-s 500 --mass-flow-kg-s 0.02 --time-ms 0.2 --spacing-m 1e-4 --seed 1"
+    )]
+    Jet(jet::JetArgs),
     /// Checks of the impact scene's own choices: `grit study settle`.
     #[command(after_help = "Example: grit study settle --angle 45 --impacts 20")]
     Study(study::StudyArgs),
@@ -97,6 +103,7 @@ fn main() -> ExitCode {
         Command::Verify(a) => sample::verify::run(a),
         Command::Shapes(a) => sample::shapes::shapes(a),
         Command::Sample(a) => sample::sample(a),
+        Command::Jet(a) => jet::jet(a),
         Command::Study(a) => study::study(a),
         Command::Plot(a) => plot::run(a),
         Command::Compare(a) => plot::compare(a),

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use grit_sph::particles::KINEMATIC;
 use grit_sph::{Particles, Vector};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -142,23 +143,21 @@ fn range(field: SurfaceField, values: &[f64]) -> (f64, Option<String>) {
     }
 }
 
-struct Layout {
-    x: (f64, f64),
-    y: (f64, f64),
-    plot: (u32, u32),
-    size: (u32, u32),
-    radius_px: f64,
+/// Where a picture of particles goes: data extent (µm), plot and image size (px), and the
+/// radius of a particle's disc (px).
+pub(crate) struct Layout {
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    pub plot: (u32, u32),
+    pub size: (u32, u32),
+    pub radius_px: f64,
 }
 
-/// Data extent in µm with a margin of one spacing, and pixel sizes at equal scale.
-fn layout(pic: &SurfacePicture, notes: usize) -> Layout {
-    let dx = pic.spacing_m * UM;
-    let pts = pic
-        .particles
-        .pos
-        .iter()
-        .chain(pic.outline_m.unwrap_or(&[]))
-        .map(|v| (v.x * UM, v.y * UM));
+/// The layout of a picture of the points `pts` (m) of spacing `spacing_m` with `notes` lines of
+/// notes: data extent in µm with a margin of one spacing, pixel sizes at equal scale.
+pub(crate) fn layout(pts: impl Iterator<Item = Vector>, spacing_m: f64, notes: usize) -> Layout {
+    let dx = spacing_m * UM;
+    let pts = pts.map(|v| (v.x * UM, v.y * UM));
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for (x, y) in pts {
         x0 = x0.min(x);
@@ -205,24 +204,39 @@ pub fn surface_png(
     let (vmax, saturated) = range(field, values);
     let mut notes = pic.notes.clone();
     notes.extend(saturated);
-    let l = layout(pic, notes.len());
+    let pts = pic
+        .particles
+        .pos
+        .iter()
+        .chain(pic.outline_m.unwrap_or(&[]))
+        .copied();
+    let l = layout(pts, pic.spacing_m, notes.len());
     let root = BitMapBackend::new(path, l.size).into_drawing_area();
-    draw(&root, pic, field, vmax, &notes, &l).map_err(failed)?;
+    let title = format!("{}: {}", capitalised(field.label()), pic.title);
+    let bar = Some((field.label(), 0.0, vmax));
+    draw_frame(&root, &title, &notes, &l, bar, |chart| {
+        draw_particles(chart, pic, field, vmax, &l)
+    })
+    .map_err(failed)?;
     root.present().map_err(de).map_err(failed)
 }
 
-fn draw<DB: DrawingBackend>(
+/// The chart a picture of particles draws on: µm against µm.
+pub(crate) type Frame<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Everything of a picture of particles but the particles: the title, axes in µm at equal scale
+/// (`plot` draws into them), a colour bar of (label, min, max) if any, and the notes.
+pub(crate) fn draw_frame<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    pic: &SurfacePicture,
-    field: SurfaceField,
-    vmax: f64,
+    title: &str,
     notes: &[String],
     l: &Layout,
+    bar: Option<(&str, f64, f64)>,
+    plot: impl FnOnce(&mut Frame<'_, DB>) -> DrawResult,
 ) -> DrawResult {
     root.fill(&WHITE).map_err(de)?;
-    let title = format!("{}: {}", capitalised(field.label()), pic.title);
     root.draw_text(
-        &title,
+        title,
         &TextStyle::from((FONT, 21).into_font()).color(&BLACK),
         (14, 12),
     )
@@ -230,7 +244,7 @@ fn draw<DB: DrawingBackend>(
     let (_, body) = root.split_vertically(TITLE_H);
     let chart_h = TOP_PAD + l.plot.1 + BOTTOM_LABELS;
     let (charts, strip) = body.split_vertically(chart_h);
-    let (main, bar) = charts.split_horizontally(LEFT_LABELS + l.plot.0 + RIGHT_PAD);
+    let (main, bar_area) = charts.split_horizontally(LEFT_LABELS + l.plot.0 + RIGHT_PAD);
 
     let mut chart = ChartBuilder::on(&main)
         .margin_top(TOP_PAD)
@@ -250,7 +264,28 @@ fn draw<DB: DrawingBackend>(
         .axis_desc_style((FONT, 16))
         .draw()
         .map_err(de)?;
+    plot(&mut chart)?;
+    if let Some((label, lo, hi)) = bar {
+        colour_bar(&bar_area, label, (lo, hi), l.plot.1)?;
+    }
+    let grey = BLACK.mix(0.8);
+    let style = TextStyle::from((FONT, 14).into_font()).color(&grey);
+    for (i, n) in notes.iter().enumerate() {
+        strip
+            .draw_text(n, &style, (14, 2 + (NOTE_LINE as i32) * i as i32))
+            .map_err(de)?;
+    }
+    Ok(())
+}
 
+/// The surface's particles coloured by `field` up to `vmax`, and the grain's outline.
+fn draw_particles<DB: DrawingBackend>(
+    chart: &mut Frame<'_, DB>,
+    pic: &SurfacePicture,
+    field: SurfaceField,
+    vmax: f64,
+    l: &Layout,
+) -> DrawResult {
     // Low values first, so damaged particles are drawn over their undamaged neighbours.
     let p = pic.particles;
     let values = field.values(p);
@@ -286,23 +321,14 @@ fn draw<DB: DrawingBackend>(
             )))
             .map_err(de)?;
     }
-    colour_bar(&bar, field, vmax, l.plot.1)?;
-
-    let grey = BLACK.mix(0.8);
-    let style = TextStyle::from((FONT, 14).into_font()).color(&grey);
-    for (i, n) in notes.iter().enumerate() {
-        strip
-            .draw_text(n, &style, (14, 2 + (NOTE_LINE as i32) * i as i32))
-            .map_err(de)?;
-    }
     Ok(())
 }
 
-/// A vertical bar of the colour map from 0 to `vmax` beside the plot, its label on top.
+/// A vertical bar of the colour map from `lo` to `hi` beside the plot, `label` on top.
 fn colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    field: SurfaceField,
-    vmax: f64,
+    label: &str,
+    (lo, hi): (f64, f64),
     plot_h: u32,
 ) -> DrawResult {
     // The bar is shorter than the plot by its caption, and never taller than 320 px.
@@ -310,7 +336,7 @@ fn colour_bar<DB: DrawingBackend>(
     let h = plot_h.saturating_sub(label_h).clamp(60, 320);
     let (top, _) = area.split_vertically(TOP_PAD + label_h + h);
     top.draw_text(
-        field.label(),
+        label,
         &TextStyle::from((FONT, 15).into_font()).color(&BLACK),
         (8, TOP_PAD as i32 + 4),
     )
@@ -320,7 +346,7 @@ fn colour_bar<DB: DrawingBackend>(
         .margin_left(8)
         .y_label_area_size(0)
         .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..1.0, 0.0..vmax)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
         .map_err(de)?;
     c.configure_mesh()
         .disable_mesh()
@@ -331,16 +357,17 @@ fn colour_bar<DB: DrawingBackend>(
         .draw()
         .map_err(de)?;
     let n = 200;
+    let at = |f: f64| lo + f * (hi - lo);
     c.draw_series((0..n).map(|k| {
         let (a, b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
         Rectangle::new(
-            [(0.0, a * vmax), (1.0, b * vmax)],
+            [(0.0, at(a)), (1.0, at(b))],
             viridis(0.5 * (a + b)).filled(),
         )
     }))
     .map_err(de)?;
     c.draw_series(std::iter::once(Rectangle::new(
-        [(0.0, 0.0), (1.0, vmax)],
+        [(0.0, lo), (1.0, hi)],
         BLACK.mix(0.6).stroke_width(1),
     )))
     .map_err(de)?;

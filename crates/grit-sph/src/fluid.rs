@@ -90,6 +90,15 @@ pub struct Fluid {
     /// Lowest (gauge) pressure the fluid sustains (Pa, ≤ 0): the EOS's tension branch is cut here,
     /// where the liquid would cavitate (docs/jet.md#water).
     pub min_pressure_pa: f64,
+    /// Coefficient δ of the density diffusion of Molteni & Colagrossi (2009) in the continuity
+    /// equation, δ h c0 Σ_b 2 (ρ̄_b − ρ̄_a) (−dW/dr / r) V_b; 0 (the AWJ paper's equations, and
+    /// the default) adds none. DualSPHysics's usual value is 0.1 (docs/jet.md#the-scene).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub density_diffusion: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Gauge pressure at which water at 20 °C boils under 1 atm: vapour pressure 2.34 kPa minus
@@ -106,6 +115,7 @@ impl Fluid {
             dynamic_viscosity_pa_s: 1.0e-3,
             artificial_viscosity: ArtificialViscosity::WATER,
             min_pressure_pa: WATER_CAVITATION_GAUGE_PA,
+            density_diffusion: 0.0,
         }
     }
 
@@ -133,6 +143,12 @@ impl Fluid {
         )?;
         self.artificial_viscosity
             .validate(&format!("{field}.artificial_viscosity"))?;
+        if !(self.density_diffusion.is_finite() && (0.0..=1.0).contains(&self.density_diffusion)) {
+            return Err(InputError::new(
+                format!("{field}.density_diffusion"),
+                format!("must lie in [0, 1], got {}", self.density_diffusion),
+            ));
+        }
         if !(self.min_pressure_pa.is_finite() && self.min_pressure_pa <= 0.0) {
             return Err(InputError::new(
                 format!("{field}.min_pressure_pa"),

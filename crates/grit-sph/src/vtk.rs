@@ -62,9 +62,6 @@ pub fn write_particles<W: Write>(
     bulk_modulus_pa: &[f64],
 ) -> io::Result<()> {
     let p = particles;
-    if !p.is_consistent() {
-        return Err(invalid("particle arrays have different lengths"));
-    }
     if let Some(&b) = p
         .body
         .iter()
@@ -75,10 +72,33 @@ pub fn write_particles<W: Write>(
             bulk_modulus_pa.len()
         )));
     }
-    let n = p.len();
-    let pressure: Vec<f64> = (0..n)
+    // Over the shortest array: a mismatch is reported by the writer below, not a panic here.
+    let n = [p.len(), p.body.len(), p.rho.len(), p.rho0.len()];
+    let pressure: Vec<f64> = (0..n.into_iter().min().unwrap_or(0))
         .map(|i| p.pressure(i, bulk_modulus_pa[p.body[i] as usize]))
         .collect();
+    write_particles_with_pressure(out, particles, &pressure)
+}
+
+/// [`write_particles`] with each particle's pressure given (`World::pressures`: a fluid's from
+/// its EOS, a metal's from its Mie–Grüneisen law), for scenes the linear law does not describe.
+pub fn write_particles_with_pressure<W: Write>(
+    out: W,
+    particles: &Particles,
+    pressure: &[f64],
+) -> io::Result<()> {
+    let p = particles;
+    if !p.is_consistent() {
+        return Err(invalid("particle arrays have different lengths"));
+    }
+    if pressure.len() != p.len() {
+        return Err(invalid(format!(
+            "{} pressures for {} particles",
+            pressure.len(),
+            p.len()
+        )));
+    }
+    let n = p.len();
     let mut w = io::BufWriter::new(out);
     header(&mut w, n, n)?;
     writeln!(
@@ -103,7 +123,7 @@ pub fn write_particles<W: Write>(
         f("stress_pa"),
         p.sdev
             .iter()
-            .zip(&pressure)
+            .zip(pressure)
             .flat_map(|(s, &pr)| cauchy_stress_3d(s, pr).into_iter().flatten()),
     )?;
     array(
@@ -142,6 +162,38 @@ pub fn write_particles<W: Write>(
     )?;
     writeln!(w, "      </PointData>")?;
     points(&mut w, &p.pos)?;
+    cells(&mut w, 0..n as u64, (1..=n as u64).collect(), VTK_VERTEX, n)?;
+    footer(&mut w)?;
+    w.flush()
+}
+
+/// Point fields `write_grains` writes, in file order: (name, components).
+pub const GRAIN_FIELDS: [(&str, usize); 3] =
+    [("velocity_m_s", 3), ("radius_m", 1), ("omega_rad_s", 1)];
+
+/// Writes abrasive grains (the AWJ paper's DEM discs) as a VTK XML UnstructuredGrid of vertex
+/// cells at their centres (m), with velocity, radius and spin; ParaView's glyph filter draws
+/// them as discs.
+pub fn write_grains<W: Write>(out: W, grains: &[crate::dem::Grain]) -> io::Result<()> {
+    let n = grains.len();
+    let mut w = io::BufWriter::new(out);
+    header(&mut w, n, n)?;
+    writeln!(
+        w,
+        r#"      <PointData Scalars="radius_m" Vectors="velocity_m_s">"#
+    )?;
+    let [vel, radius, omega] = &GRAIN_FIELDS;
+    array(
+        &mut w,
+        "Float64",
+        vel,
+        grains.iter().flat_map(|g| xyz(&g.vel)),
+    )?;
+    array(&mut w, "Float64", radius, grains.iter().map(|g| g.radius_m))?;
+    array(&mut w, "Float64", omega, grains.iter().map(|g| g.omega))?;
+    writeln!(w, "      </PointData>")?;
+    let pos: Vec<Vector> = grains.iter().map(|g| g.pos).collect();
+    points(&mut w, &pos)?;
     cells(&mut w, 0..n as u64, (1..=n as u64).collect(), VTK_VERTEX, n)?;
     footer(&mut w)?;
     w.flush()

@@ -55,7 +55,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         (0.5, 40, 400)
     };
-    let (wall_n, wall_v) = if a.quick { (16, 400.0) } else { (24, 400.0) };
+    let wall = if a.quick { (16, 400.0) } else { (24, 400.0) };
+    // The coupling-radius study's jet: the paper's d_ini = 50 µm is 20 across its 1 mm jet.
+    let rc = if a.quick { (16, 500.0) } else { (20, 500.0) };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [
@@ -66,7 +68,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         ("hourglass", Box::new(move || hourglass::run(hg_n, 0.1))),
         (
             "jet",
-            Box::new(move || jet::run(jet_dt, jet_n, jet_settle, wall_n, wall_v)),
+            Box::new(move || jet::run(jet_dt, jet_n, jet_settle, wall, rc)),
         ),
     ];
     for (name, f) in cases.iter() {

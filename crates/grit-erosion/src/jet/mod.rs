@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::campaign::MaterialSpec;
 pub use feed::{grain_spacing_m, Feed};
-pub use scene::{Layout, FIXED_SIDE_LAYERS};
+pub use scene::{Layout, FIXED_SIDE_LAYERS, WATER_DENSITY_DIFFUSION};
 
 /// Everything that defines one jet run (one sample of a jet campaign's cell); SI units except
 /// where the name says. Defaults: the paper's copper case at 500 m/s on a reduced scene
@@ -129,10 +129,22 @@ impl JetParams {
                 ),
             ));
         }
-        if cells(self.target_depth_m) < 4.0 {
+        if cells(self.target_depth_m) < 2.0 * FIXED_SIDE_LAYERS as f64 + 1.0 {
             return Err(InputError::new(
                 "target_depth_m",
-                "must be at least 4 spacings deep",
+                format!(
+                    "must be at least {} spacings deep (the fixed bottom and free material)",
+                    2 * FIXED_SIDE_LAYERS + 1
+                ),
+            ));
+        }
+        if self.standoff_m < self.jet_width_m {
+            return Err(InputError::new(
+                "standoff_m",
+                format!(
+                    "must be at least the jet width {} m, got {} m: the stagnation zone, about a jet width deep, would reach the nozzle, whose rows have no buffer, and break the jet (docs/jet.md#the-scene)",
+                    self.jet_width_m, self.standoff_m
+                ),
             ));
         }
         if self.grain_diameter_m >= self.jet_width_m {
@@ -163,6 +175,16 @@ impl JetParams {
             ));
         }
         Ok(())
+    }
+
+    /// Parses and checks a JSON object of parameters (fields left out keep their defaults);
+    /// the error names the field at fault.
+    pub fn from_json(text: &str) -> Result<JetParams, InputError> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let p: JetParams = serde_path_to_error::deserialize(de)
+            .map_err(|e| InputError::new(e.path().to_string(), e.inner().to_string()))?;
+        p.validate()?;
+        Ok(p)
     }
 
     /// Number of slices: ⌈T / slice⌉ (the last may be shorter).
@@ -208,10 +230,10 @@ pub struct JetSlice {
 #[derive(Debug, thiserror::Error)]
 pub enum JetError {
     /// The parameters are not usable.
-    #[error("{0}")]
+    #[error(transparent)]
     Input(#[from] InputError),
     /// The simulation blew up.
-    #[error("simulation failed: {0}")]
+    #[error(transparent)]
     Sim(#[from] SimError),
     /// A checkpoint could not be read or belongs to another run.
     #[error("checkpoint {0}")]
@@ -333,7 +355,11 @@ impl JetRun {
                 f(&self.world);
             }
         }
-        let slice = self.measure(k + 1, self.world.steps() - steps0, t0.elapsed().as_secs_f64())?;
+        let slice = self.measure(
+            k + 1,
+            self.world.steps() - steps0,
+            t0.elapsed().as_secs_f64(),
+        )?;
         self.slices.push(slice);
         Ok(self.slices.last())
     }

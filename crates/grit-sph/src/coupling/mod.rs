@@ -37,10 +37,6 @@ pub struct CouplingParams {
     /// Floor of a fluid particle's porosity: eq. 20 goes below zero where grains crowd (and
     /// near a lone grain for R_c ≲ 1.3 d), which would make ρ = ρ̄/ε and Ergun's 1/ε meaningless.
     pub min_porosity: f64,
-    /// Whether the fluid's EOS reads its density as ρ = ρ̄/ε (the AWJ paper's eq. 24 with
-    /// ρ̄ = ε ρ) or as ρ̄ itself, so that the grains act on the water through the coupling
-    /// forces alone (docs/jet.md#porosity-in-the-eos).
-    pub porosity_in_eos: bool,
 }
 
 impl Default for CouplingParams {
@@ -52,7 +48,6 @@ impl Default for CouplingParams {
             kernel: KernelKind::CubicSpline,
             switch_porosity: DEFAULT_SWITCH_POROSITY,
             min_porosity: 0.2,
-            porosity_in_eos: true,
         }
     }
 }

@@ -75,6 +75,7 @@ pub(crate) fn grain_porosity(
 /// onto the acceleration `acc` of each fluid particle. `theta` is θ_a of eq. 43 per world
 /// particle (pressure and laminar parts of the fluid's acceleration), `porosity` per world
 /// particle.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn coupling_forces(
     p: &Particles,
     ab: &Abrasives,
@@ -202,20 +203,6 @@ pub(crate) fn advance(ab: &mut Abrasives, dt: f64, loads: &GrainLoads) -> Result
         dem.step_loaded(sub, &force, &torque)?;
     }
     Ok(n)
-}
-
-/// The porosity (eq. 20) at point `x` from every grain of `ab`, floored like the engine's: for a
-/// particle about to join the fluid (an inflow row).
-pub(crate) fn porosity_at(ab: &Abrasives, x: Vector) -> f64 {
-    let mut eps = 1.0;
-    for g in &ab.dem.grains {
-        let k = ab.coupling.kernel(g.radius_m);
-        let r = (x - g.pos).norm();
-        if r < k.radius() {
-            eps -= k.w(r) * coupling::disc_area(g.radius_m);
-        }
-    }
-    eps.max(ab.coupling.min_porosity)
 }
 
 /// Zeroed loads for the grains of `ab`.

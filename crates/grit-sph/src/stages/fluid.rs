@@ -1,8 +1,7 @@
 //! The fluid's parts of the step (the AWJ paper eqs. 20–27, docs/jet.md#water-in-the-engine):
 //! the continuity rate of the porosity-weighted density ρ̄ and its update, then the
 //! accelerations from the updated density, both summed over the same-body pairs the kernel
-//! sums cached, and the fluid's time-step limits. The porosity ε of each particle comes from
-//! the grains (`stages::abrasives`), 1 where there are none.
+//! sums cached, and the fluid's time-step limits.
 
 use rayon::prelude::*;
 
@@ -14,6 +13,11 @@ use crate::math::Vector;
 use crate::neighbours::HalfIndex;
 use crate::particles::{Particles, KINEMATIC};
 
+/// The porosity the fluid's EOS reads: 1, so the pressure is the EOS's at ρ̄ itself. The grains
+/// reach the water through the coupling forces alone; ρ̄/ε, the paper's other reading, blew the
+/// jet up where grains cross slow water (docs/jet.md#porosity-and-the-eos).
+const EOS_POROSITY: f64 = 1.0;
+
 /// The constants of a fluid body the stages read, copied out of its [`Fluid`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FluidConst {
@@ -22,6 +26,8 @@ pub(crate) struct FluidConst {
     /// Kinematic viscosity ν = μ/ρ0 of the Shao–Lo term (eq. 25).
     pub nu: f64,
     av: ArtificialViscosity,
+    /// δ c0 of the density diffusion (`Fluid::density_diffusion`; times h in the sum).
+    delta_c0: f64,
     /// Density up to which the EOS is evaluated: 0.9 of its singular compression, so a particle
     /// crushed beyond it gets a large finite pressure instead of a division by zero.
     rho_cap: f64,
@@ -35,6 +41,7 @@ impl FluidConst {
             min_pressure: f.min_pressure_pa,
             nu: f.kinematic_viscosity(),
             av: f.artificial_viscosity,
+            delta_c0: f.density_diffusion * f.eos.c0_m_s,
             rho_cap: f.eos.rho0_kg_m3 * (1.0 + 0.9 * f.eos.singular_compression()),
         }
     }
@@ -82,8 +89,8 @@ fn pairs_of<'a>(
     })
 }
 
-/// Continuity rates dρ̄/dt (eq. 22) of every fluid particle, walls included, into `drho` (0 for
-/// the other particles), from the pairs `cache` holds for this step (`hi` names them); each
+/// Continuity rates dρ̄/dt (eq. 22, plus the fluid's density diffusion where it has one) of
+/// every fluid particle, walls included, into `drho` (0 for the other particles), from the pairs `cache` holds for this step (`hi` names them); each
 /// particle gathers its pairs in its own row's order.
 pub(crate) fn fluid_continuity(
     s: SphView<'_>,
@@ -92,25 +99,37 @@ pub(crate) fn fluid_continuity(
     drho: &mut Vec<f64>,
 ) {
     let p = s.p;
+    let h = s.k.h;
     drho.clear();
     drho.par_extend((0..p.len()).into_par_iter().par_tasks().map(|i| {
-        if s.bc[p.body[i] as usize].fluid.is_none() {
+        let Some(f) = s.bc[p.body[i] as usize].fluid else {
             return 0.0;
-        }
+        };
         let (rho_a, v_a) = (p.rho[i], p.vel[i]);
-        pairs_of(s, hi, cache, i)
+        let rate: f64 = pairs_of(s, hi, cache, i)
             .map(|(j, pair)| {
                 let grad = pair.xij * pair.dw_r;
                 fluid::continuity_rate(rho_a, p.mass[j], p.rho[j], v_a - p.vel[j], grad)
             })
-            .sum()
+            .sum();
+        if f.delta_c0 == 0.0 {
+            return rate;
+        }
+        // Molteni–Colagrossi: ψ_ab·∇_a W_ab = 2 (ρ̄_b − ρ̄_a)(−dW/dr / r), a Laplacian of ρ̄.
+        let diffusion: f64 = pairs_of(s, hi, cache, i)
+            .map(|(j, pair)| {
+                let vol = p.mass[j] / p.rho[j];
+                2.0 * (p.rho[j] - rho_a) * (-pair.dw_r) * vol
+            })
+            .sum();
+        rate + f.delta_c0 * h * diffusion
     }));
 }
 
 /// Pressure and sound speed of every particle once per step, read by each of its pairs: a fluid
-/// particle's from its EOS at ρ̄/ε (eq. 24, `porosity` ε per particle), a deformable one's from
-/// its material's pressure law and sound speed (for the fluid–solid pairs), zero otherwise.
-pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst], porosity: &[f64]) -> Vec<(f64, f64)> {
+/// particle's from its EOS (eq. 24 at ρ̄, [`EOS_POROSITY`]), a deformable one's from its
+/// material's pressure law and sound speed (for the fluid–solid pairs), zero otherwise.
+pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst]) -> Vec<(f64, f64)> {
     (0..p.len())
         .into_par_iter()
         .par_tasks()
@@ -118,8 +137,8 @@ pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst], porosity: &[f64]) 
             let c = &bc[p.body[i] as usize];
             match c.fluid {
                 Some(f) => (
-                    f.pressure(p.rho[i], porosity[i]),
-                    f.sound_speed(p.rho[i], porosity[i]),
+                    f.pressure(p.rho[i], EOS_POROSITY),
+                    f.sound_speed(p.rho[i], EOS_POROSITY),
                 ),
                 None if c.deformable => (c.pressure(p.rho[i], p.rho0[i]), c.sound),
                 None => (0.0, 0.0),
@@ -220,22 +239,14 @@ pub(crate) fn fluid_density(p: &mut Particles, bc: &[BodyConst], drho: &[f64], d
 }
 
 /// The smallest time step the fluid particles allow (s; ∞ without any): the CFL limit
-/// `cfl` · h / max(c + |v|) with c the EOS's sound speed at each particle's ρ̄/ε, and the
+/// `cfl` · h / max(c + |v|) with c the EOS's sound speed at each particle's density, and the
 /// viscous diffusion limit 0.125 h²/ν of an explicit step (Morris, Fox & Zhu 1997).
-pub(crate) fn fluid_dt(
-    p: &Particles,
-    bc: &[BodyConst],
-    porosity: &[f64],
-    h: f64,
-    cfl: f64,
-) -> f64 {
+pub(crate) fn fluid_dt(p: &Particles, bc: &[BodyConst], h: f64, cfl: f64) -> f64 {
     let fc = |i: usize| bc[p.body[i] as usize].fluid;
     let smax = (0..p.len())
         .into_par_iter()
         .par_tasks()
-        .filter_map(|i| {
-            fc(i).map(|f| f.sound_speed(p.rho[i], porosity[i]) + p.vel[i].norm())
-        })
+        .filter_map(|i| fc(i).map(|f| f.sound_speed(p.rho[i], EOS_POROSITY) + p.vel[i].norm()))
         .reduce(|| 0.0, f64::max);
     let nu_max = bc
         .iter()

@@ -58,7 +58,10 @@ pub(crate) fn interface_continuity(s: SphView<'_>, cross: &NeighbourLists, drho:
 /// The artificial-viscosity coefficients of a fluid–solid pair: the mean of the two phases'
 /// (the fluid's, and `solid` or else the fluid's again), as the pair takes the mean of their
 /// sound speeds and densities.
-fn pair_viscosity(fluid: ArtificialViscosity, solid: Option<ArtificialViscosity>) -> ArtificialViscosity {
+fn pair_viscosity(
+    fluid: ArtificialViscosity,
+    solid: Option<ArtificialViscosity>,
+) -> ArtificialViscosity {
     let solid = solid.unwrap_or(fluid);
     ArtificialViscosity {
         alpha: 0.5 * (fluid.alpha + solid.alpha),
@@ -98,7 +101,10 @@ pub(crate) fn interface_forces(
             let (mut a, mut pressure) = (Vector::zeros(), Vector::zeros());
             for (j, xij, grad) in cross_pairs(s, cross, i) {
                 let cj = &bc[p.body[j] as usize];
-                let fc = ci.fluid.or(cj.fluid).expect("a cross pair has a fluid side");
+                let fc = ci
+                    .fluid
+                    .or(cj.fluid)
+                    .expect("a cross pair has a fluid side");
                 let floor = fc.min_pressure();
                 let side = |k: usize, c: &BodyConst| {
                     let (pr, snd) = state[k];
@@ -108,7 +114,13 @@ pub(crate) fn interface_forces(
                 let rho_j = p.rho[j];
                 let f_p = -grad * (p.mass[j] / (rho_i * rho_j) * (p_i + p_j));
                 let av = pair_viscosity(fc.av(), solid_viscosity);
-                let pi = av.pi_ab(xij, v_i - p.vel[j], 0.5 * (c_i + c_j), 0.5 * (rho_i + rho_j), h);
+                let pi = av.pi_ab(
+                    xij,
+                    v_i - p.vel[j],
+                    0.5 * (c_i + c_j),
+                    0.5 * (rho_i + rho_j),
+                    h,
+                );
                 pressure += f_p;
                 a += f_p + fluid::artificial_viscosity_acceleration(p.mass[j], pi, grad);
             }

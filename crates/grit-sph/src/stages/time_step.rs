@@ -8,12 +8,11 @@ use crate::particles::Particles;
 use crate::world::Settings;
 
 /// Stable time step: CFL on the material signal speed plus particle speed over the smoothing
-/// length `h`, the fluid's limits (`fluid_dt`, at each particle's `porosity`), and the contact springs' period where
+/// length `h`, the fluid's limits (`fluid_dt`), and the contact springs' period where
 /// `Settings::contact_limits_dt` asks for it.
 pub(crate) fn stable_dt(
     p: &Particles,
     bc: &[BodyConst],
-    porosity: &[f64],
     h: f64,
     settings: &Settings,
     contacts: &[ContactPair],
@@ -29,7 +28,7 @@ pub(crate) fn stable_dt(
         dt = dt.min(settings.cfl * h / smax);
     }
     if super::any_fluid(bc) {
-        dt = dt.min(super::fluid_dt(p, bc, porosity, h, settings.cfl));
+        dt = dt.min(super::fluid_dt(p, bc, h, settings.cfl));
     }
     for c in contacts.iter().filter(|_| settings.contact_limits_dt) {
         if c.min_mass.is_finite() {

@@ -1,8 +1,8 @@
 //! Checks of the water-jet scene's building blocks with analytic references (docs/jet.md):
 //! the copper Hugoniot of the Mie–Grüneisen EOS, the DEM drop of the AWJ paper's Fig. 4, the
 //! head-on restitution of two grains, the water column at rest (`super::hydrostatic`), a
-//! grain settling through the coupling (`super::settling`) and a jet on a wall
-//! (`super::jet_wall`).
+//! grain settling through the coupling (`super::settling`), a jet on a wall
+//! (`super::jet_wall`) and one grain riding that jet onto the wall (`super::jet_grain`).
 
 use super::{CaseReport, Chart, Row, Series};
 use crate::dem::{contact_time, damping_ratio, Dem, DemParams, Grain, Wall};
@@ -39,13 +39,14 @@ fn fail(what: String) -> SimError {
 
 /// Runs all rows; the DEM steps are `dt_scale` × `Dem::time_step()`, the water column is
 /// `hydro_n` particles high, the settling grain takes `settle_steps` steps per Stokes time, and
-/// the jet on a wall has `wall_n` particles across at `wall_speed` m/s.
+/// the jet on a wall has `wall_n` particles across at `wall_speed` m/s, and the grain's jet
+/// (the coupling-radius study) `rc_n` across at `rc_speed` m/s.
 pub fn run(
     dt_scale: f64,
     hydro_n: usize,
     settle_steps: usize,
-    wall_n: usize,
-    wall_speed: f64,
+    (wall_n, wall_speed): (usize, f64),
+    (rc_n, rc_speed): (usize, f64),
 ) -> Result<CaseReport, SimError> {
     let mut rep = hugoniot()?;
     rep.extend(dem_drop(dt_scale)?);
@@ -55,6 +56,7 @@ pub fn run(
     rep.extend(super::hydrostatic::hydrostatic(hydro_n)?);
     rep.extend(super::settling::settling(settle_steps)?);
     rep.extend(super::jet_wall::jet_wall(wall_n, wall_speed)?);
+    rep.extend(super::jet_grain::rc_study(rc_n, rc_speed)?);
     Ok(rep)
 }
 
@@ -332,8 +334,8 @@ mod tests {
 
     #[test]
     fn every_row_meets_its_tolerance() {
-        let rep = run(1.0, 12, 100, 16, 400.0).unwrap();
-        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 2);
+        let rep = run(1.0, 12, 100, (16, 400.0), (16, 500.0)).unwrap();
+        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 2 + 6);
         for r in &rep.rows {
             assert!(
                 r.pass != r.expected_fail,
@@ -344,7 +346,7 @@ mod tests {
             );
             assert!(r.case.starts_with("jet_"));
         }
-        assert_eq!(rep.charts.len(), 4);
+        assert_eq!(rep.charts.len(), 5);
     }
 
     #[test]

@@ -10,6 +10,7 @@ pub mod hertz;
 pub mod hourglass;
 pub mod hydrostatic;
 pub mod jet;
+pub mod jet_grain;
 pub mod jet_wall;
 pub mod settling;
 pub mod sliding;

@@ -5,7 +5,6 @@
 use serde::{Deserialize, Serialize};
 
 use super::World;
-use crate::stages;
 use crate::coupling::{disc_area, CouplingParams};
 use crate::dem::{Dem, Grain};
 use crate::error::InputError;
@@ -150,30 +149,11 @@ impl World {
         Ok(())
     }
 
-    /// Adds a grain (a nozzle's feed); checked like the grains of [`Dem::new`]. Where the fluid's
-    /// EOS reads ρ̄/ε, the grain takes its volume out of the fluid around it at once: each
-    /// coupled fluid particle's ρ̄ = ε ρ is scaled by its new porosity over its old, so its
-    /// density ρ, and with it its pressure, is what it was (a sudden ε drop under a fixed ρ̄
-    /// would compress it by up to 1/ε).
+    /// Adds a grain (a nozzle's feed); checked like the grains of [`Dem::new`].
     pub fn add_grain(&mut self, g: Grain) -> Result<(), InputError> {
-        self.abrasives_mut("grain")?;
-        let ab = self.abrasives.as_mut().expect("checked above");
-        let p = &mut self.particles;
-        let (mut before, mut after) = (Vec::new(), Vec::new());
-        let coupled = ab.fluid_body.is_some() && ab.coupling.porosity_in_eos;
-        if coupled {
-            stages::grain_porosity(p, ab, &mut before)?;
-        }
+        let ab = self.abrasives_mut("grain")?;
         ab.dem.add(g)?;
         ab.added += 1;
-        if coupled {
-            stages::grain_porosity(p, ab, &mut after)?;
-            for ((rho, b), a) in p.rho.iter_mut().zip(&before).zip(&after) {
-                if a != b {
-                    *rho *= a / b;
-                }
-            }
-        }
         Ok(())
     }
 

@@ -45,6 +45,16 @@ pub struct NumericalWork {
 }
 
 impl World {
+    /// Each particle's pressure now (Pa): a solid's from its material's law, a fluid's from its
+    /// EOS at its density, 0 for rigid bodies (for pictures and ParaView files).
+    pub fn pressures(&self) -> Vec<f64> {
+        let bc = self.body_consts();
+        crate::stages::particle_state(&self.particles, &bc)
+            .into_iter()
+            .map(|(p, _)| p)
+            .collect()
+    }
+
     /// Kinetic, elastic, contact-spring and gravity energy (J/m).
     pub fn energy(&self) -> Energy {
         let bc = self.body_consts();

@@ -9,7 +9,6 @@ use crate::body::BodyKind;
 use crate::error::InputError;
 use crate::math::Vector;
 use crate::particles::KINEMATIC;
-use crate::stages;
 
 /// Fraction of a spacing by which the distance travelled may fall short of a whole spacing and
 /// still release a row: a step that should end exactly on the spacing lands a rounding error
@@ -193,15 +192,7 @@ impl World {
         for j in 0..per {
             let off = (j as f64 + 0.5 - 0.5 * per as f64) * dx;
             let x = nz.centre_m + nz.direction * s + across * off;
-            // A row that enters beside a grain starts at ρ̄ = ε ρ0, its density ρ0 (as
-            // `add_grain` keeps it for the fluid already there).
-            let eps = match &self.abrasives {
-                Some(ab) if ab.fluid_body == Some(b) && ab.coupling.porosity_in_eos => {
-                    stages::porosity_at(ab, x)
-                }
-                _ => 1.0,
-            };
-            self.push_particle(b, x, v, mass, rho0 * eps, 0, Vector::zeros());
+            self.push_particle(b, x, v, mass, rho0, 0, Vector::zeros());
             // As in `add_fluid`: ρ0 is the fluid's reference density.
             *self.particles.rho0.last_mut().expect("just pushed") = rho0;
         }

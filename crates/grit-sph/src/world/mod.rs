@@ -11,8 +11,8 @@ mod diagnostics;
 mod flow;
 mod settings;
 
-pub use abrasives::{plane_mass, Abrasives, GrainOutflow, PenaltyParams};
 pub use crate::stages::{CeilingPass, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
+pub use abrasives::{plane_mass, Abrasives, GrainOutflow, PenaltyParams};
 pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
@@ -51,7 +51,8 @@ struct Scratch {
     drho: Vec<f64>,
     /// Per body, the force the fluid's pair terms put on its kinematic particles.
     wall_force: Vec<Vector>,
-    /// Porosity ε of every particle (eq. 20; 1 away from grains), for this step's fluid EOS.
+    /// Porosity ε of every particle (eq. 20; 1 away from grains), for the coupling's averages
+    /// and drag (the fluid's EOS reads ρ̄ alone: docs/jet.md#porosity-and-the-eos).
     porosity: Vec<f64>,
     /// Pressure and sound speed of every particle this step (`stages::particle_state`).
     state: Vec<(f64, f64)>,
@@ -252,45 +253,13 @@ impl World {
     /// contact springs' period.
     fn compute_dt(&self) -> f64 {
         let bc = self.body_consts();
-        let mut porosity = Vec::new();
-        if stages::any_fluid(&bc) {
-            if self.porosity_in_eos() {
-                self.porosity_into(&mut porosity);
-            } else {
-                porosity.resize(self.particles.len(), 1.0);
-            }
-        }
         stages::stable_dt(
             &self.particles,
             &bc,
-            &porosity,
             self.kernel.h,
             &self.settings,
             &self.contacts,
         )
-    }
-
-    /// Whether the fluid's EOS reads ρ̄/ε (`CouplingParams::porosity_in_eos`; true without
-    /// grains, where ε = 1).
-    fn porosity_in_eos(&self) -> bool {
-        self.abrasives
-            .as_ref()
-            .is_none_or(|a| a.coupling.porosity_in_eos)
-    }
-
-    /// The porosity of every particle from the grains (eq. 20), 1 without any; returns the
-    /// frame the coupling forces reuse. A grain set that `set_abrasives` accepted always gives
-    /// pairs, so an error here is a bug.
-    fn porosity_into(&self, porosity: &mut Vec<f64>) -> stages::CouplingFrame {
-        match &self.abrasives {
-            Some(ab) => stages::grain_porosity(&self.particles, ab, porosity)
-                .expect("the grains and coupling were checked when set"),
-            None => {
-                porosity.clear();
-                porosity.resize(self.particles.len(), 1.0);
-                stages::CouplingFrame::default()
-            }
-        }
     }
 
     /// The time step the next `step` will take: CFL on the current state, and the contact
@@ -327,11 +296,11 @@ impl World {
         }
         // The rates are summed in the kernel sums' pass; their timer stays at zero in a step.
         timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
-        let fluid = stages::any_fluid(&bc);
-        if fluid {
-            let mut porosity = std::mem::take(&mut self.scratch.porosity);
-            self.scratch.frame = self.porosity_into(&mut porosity);
-            self.scratch.porosity = porosity;
+        if let Some(ab) = &self.abrasives {
+            let sc = &mut self.scratch;
+            // A grain set that `set_abrasives` accepted always gives pairs.
+            sc.frame = stages::grain_porosity(&self.particles, ab, &mut sc.porosity)
+                .expect("the grains and coupling were checked when set");
         }
         timers.time(Stage::Stress, || self.stress(&bc, dt));
         timers.time(Stage::Forces, || self.forces(&bc, dt));
@@ -517,7 +486,6 @@ impl World {
     }
 
     fn forces(&mut self, bc: &[BodyConst], dt: f64) {
-        let in_eos = self.porosity_in_eos();
         let s = SphView {
             p: &self.particles,
             nl: &self.nbrs.same,
@@ -541,14 +509,7 @@ impl World {
         self.work.hourglass += hg;
         if stages::any_fluid(bc) {
             let g = self.settings.gravity_m_s2;
-            let ones;
-            let eos_porosity = if in_eos {
-                &sc.porosity
-            } else {
-                ones = vec![1.0; sc.porosity.len()];
-                &ones
-            };
-            sc.state = stages::particle_state(s.p, bc, eos_porosity);
+            sc.state = stages::particle_state(s.p, bc);
             let (hi, state) = (&self.nbrs.half, &sc.state);
             stages::fluid_accelerations(s, hi, &sc.pairs, state, g, &mut sc.acc, &mut sc.theta);
             if self.nbrs.cross.pairs() > 0 {

@@ -1,0 +1,199 @@
+//! `grit jet`: one abrasive water-jet run on this machine (docs/jet.md): crater depth and width,
+//! mass loss and plastic strain against time, with a progress bar, optional JSON and snapshots.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::Context;
+use grit_erosion::campaign::MaterialSpec;
+use grit_erosion::jet::{JetParams, JetRun, JetSlice};
+use grit_sph::crater::CraterSample;
+use serde::Serialize;
+
+use super::output::{say, write_json};
+use super::{pool, progress};
+
+mod snapshots;
+
+/// Arguments of `grit jet`.
+#[derive(clap::Args)]
+pub struct JetArgs {
+    /// A JSON file of scene parameters (any `JetParams` field: docs/jet.md#the-scene); the
+    /// flags below override it.
+    #[arg(long, value_name = "FILE")]
+    scene: Option<PathBuf>,
+    /// Target material: copper, al6061 or aisi304.
+    #[arg(long)]
+    material: Option<String>,
+    /// Jet speed at the nozzle (m/s).
+    #[arg(long)]
+    velocity_m_s: Option<f64>,
+    /// Abrasive mass flow (kg/s); 0 for a pure water jet.
+    #[arg(long)]
+    mass_flow_kg_s: Option<f64>,
+    /// Simulated time (ms).
+    #[arg(long)]
+    time_ms: Option<f64>,
+    /// Time between crater samples (ms).
+    #[arg(long)]
+    slice_ms: Option<f64>,
+    /// Particle spacing of water and target (m).
+    #[arg(long)]
+    spacing_m: Option<f64>,
+    /// Coupling radius over grain diameter.
+    #[arg(long)]
+    coupling_radius_d: Option<f64>,
+    /// Seed of the abrasive placement.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads of the engine (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Print the result as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Also write the JSON result to this file.
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+    /// Write pictures (PNG: phase, pressure, damage) and ParaView files (VTU, PVD) of the scene
+    /// at the end of every `--snapshot-every`-th slice into this folder.
+    #[arg(long, value_name = "DIR")]
+    snapshots: Option<PathBuf>,
+    /// Slices between snapshots.
+    #[arg(long, default_value_t = 1, requires = "snapshots")]
+    snapshot_every: u32,
+}
+
+/// What `--json` prints.
+#[derive(Serialize)]
+struct JetOutput<'a> {
+    params: &'a JetParams,
+    seed: u64,
+    /// One point per slice: t, mass loss per metre, Cd, Cw, largest plastic strain.
+    series: Vec<CraterSample>,
+    /// The slices with their profiles and costs.
+    slices: &'a [JetSlice],
+    /// Wall-clock seconds of the run.
+    wall_s: f64,
+    /// Why the run stopped early, if it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
+}
+
+impl JetArgs {
+    /// The parameters: the scene file's, then the flags.
+    fn params(&self) -> anyhow::Result<JetParams> {
+        let mut p = match &self.scene {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("--scene {}", path.display()))?;
+                JetParams::from_json(&text)
+                    .with_context(|| format!("--scene {}", path.display()))?
+            }
+            None => JetParams::default(),
+        };
+        if let Some(m) = &self.material {
+            p.material = MaterialSpec(grit_sph::Material::by_name(m)?);
+        }
+        let set = |dst: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *dst = v;
+            }
+        };
+        set(&mut p.velocity_m_s, self.velocity_m_s);
+        set(&mut p.mass_flow_kg_s, self.mass_flow_kg_s);
+        set(&mut p.time_ms, self.time_ms);
+        set(&mut p.slice_ms, self.slice_ms);
+        set(&mut p.spacing_m, self.spacing_m);
+        set(&mut p.coupling_radius_d, self.coupling_radius_d);
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+/// Runs one jet with a progress bar over simulated time and prints its crater series.
+pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
+    let params = a.params()?;
+    let mut run = JetRun::new(params.clone(), a.seed)?;
+    let mut snaps = match &a.snapshots {
+        Some(dir) => Some(snapshots::Snapshots::new(dir, a.snapshot_every)?),
+        None => None,
+    };
+    let pool = pool(a.threads)?;
+    // The bar counts simulated microseconds.
+    let total_us = (params.time_ms * 1e3).ceil() as u64;
+    let bar = progress::bar(total_us, "µs simulated", !a.json);
+    let t0 = Instant::now();
+    let mut failure = None;
+    while !run.finished() {
+        let ran = pool.install(|| {
+            run.run_next_slice_observed(
+                &|| false,
+                Some(&mut |w: &grit_sph::World| bar.set_position((w.time() * 1e6) as u64)),
+            )
+            .map(|_| ())
+        });
+        if let Err(e) = ran {
+            failure = Some(e);
+            break;
+        }
+        let s = run.slices().last().expect("a slice just finished");
+        bar.set_message(format!(
+            "Cd {:.1} µm, Cw {:.1} µm, loss {:.3e} kg/m, {} grains",
+            s.sample.crater_depth_m * 1e6,
+            s.sample.crater_width_m * 1e6,
+            s.sample.mass_loss_kg_m,
+            s.grains
+        ));
+        if let Some(sn) = snaps.as_mut() {
+            sn.write(&run)?;
+        }
+    }
+    bar.finish();
+    let out = JetOutput {
+        params: &params,
+        seed: a.seed,
+        series: run.slices().iter().map(|s| s.sample).collect(),
+        slices: run.slices(),
+        wall_s: t0.elapsed().as_secs_f64(),
+        error: failure.as_ref().map(|e| e.to_string()),
+    };
+    if let Some(path) = &a.out {
+        write_json(path, &out)?;
+    }
+    if a.json {
+        say!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        say!(
+            "{:>9} {:>12} {:>10} {:>10} {:>8} {:>7}",
+            "t (ms)",
+            "loss (kg/m)",
+            "Cd (µm)",
+            "Cw (µm)",
+            "eps_p",
+            "grains"
+        );
+        for s in run.slices() {
+            let c = &s.sample;
+            say!(
+                "{:>9.4} {:>12.4e} {:>10.1} {:>10.1} {:>8.3} {:>7}",
+                c.t_s * 1e3,
+                c.mass_loss_kg_m,
+                c.crater_depth_m * 1e6,
+                c.crater_width_m * 1e6,
+                c.max_plastic_strain,
+                s.grains
+            );
+        }
+        say!("{:.1} s wall", out.wall_s);
+    }
+    match failure {
+        Some(e) => Err(anyhow::anyhow!(e).context(format!(
+            "the run stopped after {} of {} slices (the slices before are above)",
+            run.slices_done(),
+            run.slices_total()
+        ))),
+        None => Ok(ExitCode::SUCCESS),
+    }
+}
