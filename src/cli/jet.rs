@@ -139,13 +139,24 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
             break;
         }
         let s = run.slices().last().expect("a slice just finished");
-        bar.set_message(format!(
+        let msg = format!(
             "Cd {:.1} µm, Cw {:.1} µm, loss {:.3e} kg/m, {} grains",
             s.sample.crater_depth_m * 1e6,
             s.sample.crater_width_m * 1e6,
             s.sample.mass_loss_kg_m,
             s.grains
-        ));
+        );
+        // Without a terminal (a log file) the bar is hidden: a line per slice instead.
+        if bar.is_hidden() && !a.json {
+            eprintln!(
+                "slice {}/{}: t = {:.1} µs, {msg}, {:.1} s",
+                s.slice,
+                run.slices_total(),
+                s.sample.t_s * 1e6,
+                s.wall_s
+            );
+        }
+        bar.set_message(msg);
         if let Some(sn) = snaps.as_mut() {
             sn.write(&run)?;
         }
