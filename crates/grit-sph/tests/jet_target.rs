@@ -21,6 +21,17 @@ fn lattice(nx: usize, ny: usize, origin: Vector) -> Vec<Vector> {
     pts
 }
 
+/// A grain set without grains or walls, garnet constants, no gravity.
+fn no_grains() -> Dem {
+    Dem::new(
+        Vec::new(),
+        Vec::new(),
+        DemParams::default(),
+        Vector::zeros(),
+    )
+    .unwrap()
+}
+
 /// A free copper block (no fixed particles, no gravity) with a block of water above it moving
 /// down onto it at `speed`, and, with `grains`, garnet grains in the water coupled to it.
 fn water_on_copper(speed: f64, grains: bool) -> World {
@@ -42,13 +53,7 @@ fn water_on_copper(speed: f64, grains: bool) -> World {
         .add_fluid("water", Fluid::water(), &water, &vols, &pres, v)
         .unwrap();
     if grains {
-        let dem = Dem::new(
-            Vec::new(),
-            Vec::new(),
-            DemParams::default(),
-            Vector::zeros(),
-        )
-        .unwrap();
+        let dem = no_grains();
         w.set_abrasives(Abrasives::new(
             dem,
             CouplingParams::default(),
@@ -149,13 +154,7 @@ fn abrasive_inputs_are_checked() {
     let mut w = water_on_copper(10.0, false);
     let g = Grain::sphere(Vector::zeros(), 1e-4, 4120.0);
     assert_eq!(w.add_grain(g).unwrap_err().field, "grain");
-    let dem = Dem::new(
-        Vec::new(),
-        Vec::new(),
-        DemParams::default(),
-        Vector::zeros(),
-    )
-    .unwrap();
+    let dem = no_grains();
     let bad_body = Abrasives::new(
         dem.clone(),
         CouplingParams::default(),

@@ -2,7 +2,7 @@
 //! body of the engine under gravity, held by wall particles of its own, against
 //! p = ρ0 g (H − y).
 
-use super::{CaseReport, Chart, Row, Series};
+use super::{fail, CaseReport, Chart, Row, Series};
 use crate::error::SimError;
 use crate::fluid::Fluid;
 use crate::math::Vector;
@@ -24,14 +24,6 @@ const WINDOW_TIMES: f64 = 2.0;
 const SAMPLE_EVERY: u64 = 10;
 /// The tolerance for the hydrostatic check.
 const TOL_HYDROSTATIC: f64 = 0.02;
-
-fn fail(what: String) -> SimError {
-    SimError {
-        step: 0,
-        time_s: 0.0,
-        what,
-    }
-}
 
 /// Water with the sound speed of the check, c0 = 10 √(g H): the rest of the preset's EOS is
 /// kept, so the engine evaluates the same law as for the jet, 150 times softer.

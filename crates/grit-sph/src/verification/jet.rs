@@ -4,7 +4,7 @@
 //! grain settling through the coupling (`super::settling`), a jet on a wall
 //! (`super::jet_wall`) and one grain riding that jet onto the wall (`super::jet_grain`).
 
-use super::{CaseReport, Chart, Row, Series};
+use super::{fail, CaseReport, Chart, Row, Series};
 use crate::dem::{contact_time, damping_ratio, Dem, DemParams, Grain, Wall};
 use crate::eos::EquationOfState;
 use crate::error::SimError;
@@ -28,14 +28,6 @@ pub const HUGONIOT_P: f64 = 7.59e9;
 const TOL_HUGONIOT: f64 = 0.02;
 const TOL_DROP: f64 = 0.01;
 const TOL_RESTITUTION: f64 = 0.02;
-
-fn fail(what: String) -> SimError {
-    SimError {
-        step: 0,
-        time_s: 0.0,
-        what,
-    }
-}
 
 /// Runs all rows; the DEM steps are `dt_scale` × `Dem::time_step()`, the water column is
 /// `hydro_n` particles high, the settling grain takes `settle_steps` steps per Stokes time, and

@@ -9,7 +9,7 @@
 //! wall particles' surface; the grain meets the water only through the coupling.
 
 use super::jet_wall::{jet_wall_world, JET_B};
-use super::{CaseReport, Chart, Row, Series};
+use super::{fail, CaseReport, Chart, Row, Series};
 use crate::coupling::CouplingParams;
 use crate::dem::{Dem, DemParams, Grain, Wall};
 use crate::error::SimError;
@@ -29,14 +29,6 @@ const GRAIN_RHO: f64 = 4120.0;
 const SETTLE_B_OVER_V: f64 = 6.0;
 /// The bound on the contact speed at R_c = 2.0 d.
 const TOL_CONTACT: f64 = 0.05;
-
-fn fail(what: String) -> SimError {
-    SimError {
-        step: 0,
-        time_s: 0.0,
-        what,
-    }
-}
 
 /// What one grain's ride measured.
 #[derive(Debug, Clone)]

@@ -3,7 +3,7 @@
 //! the fluid's own body, spread into two sheets along the wall and leave through an outflow box
 //! (`World::add_outflow`). The wall's load is compared with the jet's momentum flux ρ0 v² b.
 
-use super::{CaseReport, Chart, Row, Series};
+use super::{fail, CaseReport, Chart, Row, Series};
 use crate::error::SimError;
 use crate::fluid::Fluid;
 use crate::math::Vector;
@@ -26,14 +26,6 @@ const WINDOW_B_OVER_V: (f64, f64) = (6.0, 14.0);
 const HAMMER_B_OVER_V: f64 = 1.0;
 /// The tolerance for the jet on a wall.
 const TOL_JET_WALL: f64 = 0.05;
-
-fn fail(what: String) -> SimError {
-    SimError {
-        step: 0,
-        time_s: 0.0,
-        what,
-    }
-}
 
 /// What a jet-on-wall run measured.
 #[derive(Debug, Clone)]

@@ -16,6 +16,15 @@ pub mod settling;
 pub mod sliding;
 pub mod slope;
 
+/// A case that could not be set up or run, as the error the cases return.
+pub(crate) fn fail(what: String) -> crate::error::SimError {
+    crate::error::SimError {
+        step: 0,
+        time_s: 0.0,
+        what,
+    }
+}
+
 /// One line of the verification table. Field names are read by scripts: keep them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {

@@ -3,7 +3,7 @@
 //! against `coupling::terminal_velocity`, with the coupling's action–reaction and porosity
 //! volume checked at every step.
 
-use super::{CaseReport, Chart, Row, Series};
+use super::{fail, CaseReport, Chart, Row, Series};
 use crate::coupling::{
     coupling_forces, disc_area, find_pairs, porosity, sphere_force, stokes_relaxation_time,
     stokes_velocity, terminal_velocity, CouplingParams, FluidView,
@@ -27,14 +27,6 @@ const WINDOW_TAUS: f64 = 1.0;
 /// Tolerances of the table: settling 5 %, coupling 1 %.
 const TOL_SETTLING: f64 = 0.05;
 const TOL_COUPLING: f64 = 0.01;
-
-fn fail(what: String) -> SimError {
-    SimError {
-        step: 0,
-        time_s: 0.0,
-        what,
-    }
-}
 
 /// The largest of the per-step checks of the coupling.
 #[derive(Debug, Default, Clone, Copy)]
