@@ -59,6 +59,9 @@ pub struct JetPicture<'a> {
     pub spacing_m: f64,
     /// Grains: centre (m) and radius (m).
     pub grains: Vec<(Vector, f64)>,
+    /// The part of the plane shown (lower-left and upper-right corners, m); what lies outside
+    /// (fragments flung far off) is left out. `None` shows everything.
+    pub view_m: Option<(Vector, Vector)>,
     /// Title line; the field's name is put in front of it.
     pub title: String,
     /// Lines of notes under the plot.
@@ -103,13 +106,18 @@ pub fn jet_png(pic: &JetPicture, field: JetField, path: &Path) -> Result<(), Plo
         }
         JetField::Damage => (Some(("damage D", 0.0, 1.0)), "damage"),
     };
-    let pts = pic
-        .particles
-        .pos
-        .iter()
-        .copied()
-        .chain(pic.grains.iter().map(|g| g.0));
-    let l = layout(pts, pic.spacing_m, pic.notes.len());
+    let inside = |x: &Vector| {
+        pic.view_m
+            .is_none_or(|(lo, hi)| x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y)
+    };
+    let l = match pic.view_m {
+        Some((lo, hi)) => layout([lo, hi].into_iter(), pic.spacing_m, pic.notes.len()),
+        None => {
+            let pts = pic.particles.pos.iter().copied();
+            let pts = pts.chain(pic.grains.iter().map(|g| g.0));
+            layout(pts, pic.spacing_m, pic.notes.len())
+        }
+    };
     let root = BitMapBackend::new(path, l.size).into_drawing_area();
     let title = format!("{label}: {}", pic.title);
     let r_px = l.radius_px;
@@ -143,12 +151,12 @@ pub fn jet_png(pic: &JetPicture, field: JetField, path: &Path) -> Result<(), Plo
                 }
             };
             chart
-                .draw_series((0..p.len()).map(|i| {
+                .draw_series((0..p.len()).filter(|&i| inside(&p.pos[i])).map(|i| {
                     Circle::new((p.pos[i].x * UM, p.pos[i].y * UM), r_px, colour(i).filled())
                 }))
                 .map_err(de)?;
             chart
-                .draw_series(pic.grains.iter().map(|(c, r)| {
+                .draw_series(pic.grains.iter().filter(|g| inside(&g.0)).map(|(c, r)| {
                     let px = (r * UM * scale).max(2.0);
                     Circle::new((c.x * UM, c.y * UM), px, GRAIN.filled())
                 }))

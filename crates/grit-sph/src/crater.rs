@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::InputError;
 use crate::math::Vector;
-use crate::particles::Particles;
+use crate::particles::{Particles, KINEMATIC};
 
 /// How the profile is sampled.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,14 +20,19 @@ pub struct CraterOptions {
     /// A column counts as cratered when its surface lies more than this below the original
     /// line (m); half a particle spacing keeps surface roughness out of the width.
     pub depth_tol_m: f64,
+    /// Two target particles closer than this hang together ([`attached`]); a piece joined to
+    /// no fixed particle is a fragment, left out of the profile.
+    pub link_m: f64,
 }
 
 impl CraterOptions {
-    /// Columns one spacing wide, tolerance half a spacing.
+    /// Columns one spacing wide, tolerance half a spacing, pieces linked within 1.5 spacings
+    /// (the lattice's diagonal neighbours are 1.41 apart).
     pub fn for_spacing(spacing_m: f64) -> Self {
         CraterOptions {
             bin_m: spacing_m,
             depth_tol_m: 0.5 * spacing_m,
+            link_m: 1.5 * spacing_m,
         }
     }
 }
@@ -67,9 +72,10 @@ pub struct CraterSample {
     pub max_plastic_strain: f64,
 }
 
-/// The time-series point of target body `body` at time `t_s`: Cd and Cw from its live
-/// particles, its largest plastic strain, and `mass_loss_kg_m` as the world booked it (the
-/// body's removed mass per unit depth).
+/// The time-series point of target body `body` at time `t_s`, and its crater: Cd and Cw from
+/// its particles that hang together with its fixed (kinematic) ones ([`attached`]; all of them
+/// when it has none), the largest plastic strain among those, and `mass_loss_kg_m` as the
+/// caller books it.
 pub fn sample(
     t_s: f64,
     particles: &Particles,
@@ -77,23 +83,82 @@ pub fn sample(
     mass_loss_kg_m: f64,
     surface_y_m: f64,
     opts: CraterOptions,
-) -> Result<CraterSample, InputError> {
-    let mut pos = Vec::new();
+) -> Result<(CraterSample, Crater), InputError> {
+    let of_body: Vec<usize> = (0..particles.len())
+        .filter(|&i| particles.body[i] == body)
+        .collect();
+    let pos: Vec<Vector> = of_body.iter().map(|&i| particles.pos[i]).collect();
+    let fixed: Vec<bool> = of_body
+        .iter()
+        .map(|&i| particles.flags.get(i).is_some_and(|f| f & KINEMATIC != 0))
+        .collect();
+    let keep = if fixed.iter().any(|&f| f) {
+        attached(&pos, &fixed, opts.link_m)?
+    } else {
+        vec![true; pos.len()]
+    };
+    let mut kept = Vec::with_capacity(pos.len());
     let mut max_eps = 0.0f64;
-    for (i, &b) in particles.body.iter().enumerate() {
-        if b == body {
-            pos.push(particles.pos[i]);
+    for (k, &i) in of_body.iter().enumerate() {
+        if keep[k] {
+            kept.push(pos[k]);
             max_eps = max_eps.max(particles.eps_p[i]);
         }
     }
-    let c = crater(&pos, surface_y_m, opts)?;
-    Ok(CraterSample {
+    let c = crater(&kept, surface_y_m, opts)?;
+    let s = CraterSample {
         t_s,
         mass_loss_kg_m,
         crater_depth_m: c.depth_m,
         crater_width_m: c.width_m,
         max_plastic_strain: max_eps,
-    })
+    };
+    Ok((s, c))
+}
+
+/// Which of `positions` hang together with a particle marked in `anchored`, through a chain of
+/// particles each closer than `link_m` to the next: the rest are fragments cut loose from the
+/// target (they still fly, and count as target, until deleted). A breadth-first search over a
+/// grid of cells `link_m` wide.
+pub fn attached(
+    positions: &[Vector],
+    anchored: &[bool],
+    link_m: f64,
+) -> Result<Vec<bool>, InputError> {
+    InputError::require_positive("crater.link_m", link_m)?;
+    if anchored.len() != positions.len() {
+        return Err(InputError::new(
+            "crater.anchored",
+            format!(
+                "has {} entries for {} positions",
+                anchored.len(),
+                positions.len()
+            ),
+        ));
+    }
+    let cell = |p: &Vector| ((p.x / link_m).floor() as i64, (p.y / link_m).floor() as i64);
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    for (i, p) in positions.iter().enumerate() {
+        grid.entry(cell(p)).or_default().push(i);
+    }
+    let mut joined = anchored.to_vec();
+    let mut queue: std::collections::VecDeque<usize> =
+        (0..positions.len()).filter(|&i| anchored[i]).collect();
+    let link2 = link_m * link_m;
+    while let Some(i) = queue.pop_front() {
+        let (cx, cy) = cell(&positions[i]);
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                for &j in grid.get(&(cx + dx, cy + dy)).into_iter().flatten() {
+                    if !joined[j] && (positions[j] - positions[i]).norm_squared() < link2 {
+                        joined[j] = true;
+                        queue.push_back(j);
+                    }
+                }
+            }
+        }
+    }
+    Ok(joined)
 }
 
 /// The topmost particle of each `bin_m`-wide column, columns centred on x_min + k·bin_m (so a
@@ -355,7 +420,8 @@ mod tests {
         p.pos.push(Vector::new(0.0, 3.0 * S));
         p.body.push(0);
         p.eps_p.push(9.0);
-        let s = sample(1e-3, &p, 1, 2.5e-6, 0.0, CraterOptions::for_spacing(S)).unwrap();
+        let (s, c) = sample(1e-3, &p, 1, 2.5e-6, 0.0, CraterOptions::for_spacing(S)).unwrap();
+        assert_eq!(c.depth_m, s.crater_depth_m);
         assert!((s.crater_depth_m - 5.0 * S).abs() < 1e-15);
         assert!((s.crater_width_m - 20.0 * S * (1.0 - 0.1)).abs() < 1e-12);
         assert_eq!(
@@ -377,6 +443,42 @@ mod tests {
                 .unwrap_err()
                 .field,
             "crater.positions"
+        );
+    }
+
+    #[test]
+    fn fragments_cut_loose_are_left_out() {
+        // A V crater in a block fixed along its bottom row, a fragment flying above the
+        // crater's deepest point, and a chain hanging on the surface by diagonal links.
+        let mut p = Particles::default();
+        for x in block(30, |x| (5.0 * S * (1.0 - x.abs() / (10.0 * S))).max(0.0)) {
+            p.pos.push(x);
+            p.body.push(1);
+            p.eps_p.push(0.1);
+            p.flags.push(if x.y < -9.0 * S { KINEMATIC } else { 0 });
+        }
+        let deepest = -5.0 * S;
+        let fragment = Vector::new(0.0, deepest + 3.0 * S);
+        for x in [fragment, Vector::new(-0.2 * S, deepest + 3.5 * S)] {
+            p.pos.push(x);
+            p.body.push(1);
+            p.eps_p.push(7.0);
+            p.flags.push(0);
+        }
+        let (s, _) = sample(0.0, &p, 1, 0.0, 0.0, CraterOptions::for_spacing(S)).unwrap();
+        assert!(
+            (s.crater_depth_m - 5.0 * S).abs() < 1e-12,
+            "{}",
+            s.crater_depth_m
+        );
+        assert_eq!(s.max_plastic_strain, 0.1);
+        // Diagonal neighbours (1.41 S) link; a particle 2 S from all others does not.
+        let chain = [Vector::zeros(), Vector::new(S, S), Vector::new(3.0 * S, S)];
+        let joined = attached(&chain, &[true, false, false], 1.5 * S).unwrap();
+        assert_eq!(joined, vec![true, true, false]);
+        assert_eq!(
+            attached(&chain, &[true], S).unwrap_err().field,
+            "crater.anchored"
         );
     }
 

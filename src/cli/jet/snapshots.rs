@@ -76,6 +76,7 @@ impl Snapshots {
             fluid_body: run.layout().fluid_body as u32,
             spacing_m: p.spacing_m,
             grains: grains.iter().map(|g| (g.pos, g.radius_m)).collect(),
+            view_m: Some((run.layout().box_min_m, run.layout().box_max_m)),
             title: format!(
                 "t = {:.1} µs, {} at {} m/s, M = {} kg/s, Δx {} µm",
                 w.time() * 1e6,

@@ -364,26 +364,29 @@ impl JetRun {
         Ok(self.slices.last())
     }
 
-    /// The crater and state now, as slice `slice`.
+    /// The crater and state now, as slice `slice`. The mass loss is the target's deleted
+    /// particles (D ≥ 1) and the fragments that left the scene; the crater is measured on the
+    /// target that still hangs together with its fixed particles.
     fn measure(&self, slice: u32, steps: u64, wall_s: f64) -> Result<JetSlice, JetError> {
         let w = &self.world;
         let opts = CraterOptions::for_spacing(self.params.spacing_m);
         let target = self.layout.target_body;
-        let removed = w.bodies()[target].removed_mass_kg_m;
+        let fragments: f64 = w
+            .outflows()
+            .iter()
+            .filter(|o| o.body == target)
+            .map(|o| o.mass_kg_m)
+            .sum();
+        let loss = w.bodies()[target].removed_mass_kg_m + fragments;
         let p = w.particles();
-        let sample = crater::sample(
+        let (sample, c) = crater::sample(
             w.time(),
             p,
             target as u32,
-            removed,
+            loss,
             self.layout.surface_y_m,
             opts,
         )?;
-        let pos: Vec<_> = (0..p.len())
-            .filter(|&i| p.body[i] as usize == target)
-            .map(|i| p.pos[i])
-            .collect();
-        let c = crater::crater(&pos, self.layout.surface_y_m, opts)?;
         Ok(JetSlice {
             slice,
             sample,

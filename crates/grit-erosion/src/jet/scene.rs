@@ -15,8 +15,8 @@ use super::JetParams;
 /// (docs/jet.md#the-scene).
 pub const FIXED_SIDE_LAYERS: u32 = 3;
 
-/// Margin of the outflow box beyond the target and the nozzle, in spacings: water and grains
-/// leave once they are past the target's sides.
+/// Margin of the outflow box beyond the target and the nozzle, in spacings: water, grains and
+/// target fragments leave once they are past the target's sides.
 const OUTFLOW_MARGIN_DX: f64 = 4.0;
 
 /// Gravity of the scene (m/s²): the paper's eq. 1 and 23 keep it, though at jet speeds it does
@@ -111,6 +111,8 @@ pub fn build(params: &JetParams) -> Result<(World, Layout), InputError> {
     let water = world.add_fluid("water", jet_water(), &[], &[], &[], Vector::zeros())?;
     debug_assert_eq!((target, water), (layout.target_body, layout.fluid_body));
     world.add_outflow(water, layout.box_min_m, layout.box_max_m)?;
+    // Fragments of the target that fly out of the scene are deleted and booked as loss.
+    world.add_outflow(target, layout.box_min_m, layout.box_max_m)?;
     world.add_inflow(
         water,
         Nozzle {

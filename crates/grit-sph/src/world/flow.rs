@@ -137,16 +137,25 @@ impl World {
         Ok(k)
     }
 
-    /// Deletes the free particles of fluid body `b` that leave the box `min_m`–`max_m` from now
-    /// on, at the end of each step, booking their number and mass (docs/jet.md#inflow-and-outflow).
-    /// Returns the outflow's index. Errors name `outflow.<field>`.
+    /// Deletes the free particles of fluid or deformable body `b` that leave the box
+    /// `min_m`–`max_m` from now on, at the end of each step, booking their number and mass
+    /// (docs/jet.md#inflow-and-outflow; for a target, the fragments it loses). Returns the
+    /// outflow's index. Errors name `outflow.<field>`.
     pub fn add_outflow(
         &mut self,
         b: usize,
         min_m: Vector,
         max_m: Vector,
     ) -> Result<usize, InputError> {
-        self.fluid_body(b, "outflow.body")?;
+        if !matches!(
+            self.bodies.get(b).map(|x| &x.kind),
+            Some(BodyKind::Fluid { .. } | BodyKind::Deformable { .. })
+        ) {
+            return Err(InputError::new(
+                "outflow.body",
+                format!("body {b} is neither a fluid nor a deformable body"),
+            ));
+        }
         if !(finite(min_m) && finite(max_m)) {
             return Err(InputError::new("outflow.min_m", "corners must be finite"));
         }
