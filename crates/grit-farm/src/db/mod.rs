@@ -22,8 +22,11 @@ mod campaigns;
 mod checkpoints;
 mod extend;
 mod group;
+mod jet;
 mod worker;
 mod workers;
+
+pub use worker::Reported;
 
 #[cfg(test)]
 mod extend_tests;
