@@ -386,7 +386,7 @@ pub fn assess_stage3(mean: &[JetMeanPoint], samples: &[JetSampleInput]) -> Stage
     ) {
         if lo != hi {
             broken.push(format!(
-                "the window's points average {lo} to {hi} samples: some are still running"
+                "the window's points average {lo} to {hi} samples: some samples stopped short (still running or failed)"
             ));
         }
     }
