@@ -33,6 +33,8 @@ mod extend_tests;
 #[cfg(test)]
 mod group_tests;
 #[cfg(test)]
+mod jet_tests;
+#[cfg(test)]
 mod tests;
 
 /// Current time in Unix milliseconds.
