@@ -2,7 +2,9 @@
 //! are written (pictures not blank, ParaView files readable as XML with every particle), and bad
 //! input is refused with the field named and a non-zero exit.
 
-use std::path::Path;
+mod common;
+
+use common::png_ok;
 use std::process::{Command, Output};
 
 fn grit(args: &[&str]) -> Output {
@@ -16,14 +18,6 @@ fn grit(args: &[&str]) -> Output {
 const TINY: &str = r#"{"spacing_m": 1e-4, "jet_width_m": 6e-4, "target_width_m": 3e-3,
     "target_depth_m": 8e-4, "standoff_m": 6e-4, "grain_diameter_m": 2e-4,
     "mass_flow_kg_s": 0.01, "time_ms": 0.003, "slice_ms": 0.001}"#;
-
-fn png_ok(path: &Path) {
-    let img = image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgb8();
-    let colours: std::collections::BTreeSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
-    assert!(colours.len() > 3, "{} is blank", path.display());
-}
 
 #[test]
 fn a_small_jet_prints_its_series_and_writes_snapshots() {

@@ -2,7 +2,9 @@
 //! what fails, write their CSV, JSON and charts, resume without redoing points, and refuse bad
 //! input clearly.
 
-use std::path::Path;
+mod common;
+
+use common::png_ok;
 use std::process::{Command, Output};
 
 use grit_erosion::studies::stability::{Failure, Panel, StabilityPoint, Verdict};
@@ -23,14 +25,6 @@ fn ok(out: &Output) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     stdout
-}
-
-fn png_ok(path: &Path) {
-    let img = image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgb8();
-    let colours: std::collections::BTreeSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
-    assert!(colours.len() > 3, "{} is blank", path.display());
 }
 
 /// 8 particles per Dg (31.25 µm): the coarsest scene the validation accepts, seconds a point.

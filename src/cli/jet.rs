@@ -11,7 +11,7 @@ use grit_erosion::jet::{JetParams, JetRun, JetSlice};
 use grit_sph::crater::CraterSample;
 use serde::Serialize;
 
-use super::output::{say, write_json};
+use super::output::{say, write_bytes, write_json};
 use super::{pool, progress};
 
 mod snapshots;
@@ -63,6 +63,14 @@ pub struct JetArgs {
     /// Slices between snapshots.
     #[arg(long, default_value_t = 1, requires = "snapshots")]
     snapshot_every: u32,
+    /// Write the run's whole state to this file after every slice (atomically), so a killed
+    /// run loses at most one slice.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Go on from a checkpoint file with the parameters and seed stored in it; `--time-ms` may
+    /// run it longer, the other scene flags must be left out.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["scene", "material", "velocity_m_s", "mass_flow_kg_s", "slice_ms", "spacing_m", "coupling_radius_d"])]
+    resume: Option<PathBuf>,
 }
 
 /// What `--json` prints.
@@ -114,8 +122,21 @@ impl JetArgs {
 
 /// Runs one jet with a progress bar over simulated time and prints its crater series.
 pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
-    let params = a.params()?;
-    let mut run = JetRun::new(params.clone(), a.seed)?;
+    let mut run = match &a.resume {
+        Some(path) => {
+            let bytes =
+                std::fs::read(path).with_context(|| format!("--resume {}", path.display()))?;
+            let mut run = JetRun::from_checkpoint(&bytes)
+                .with_context(|| format!("--resume {}", path.display()))?;
+            if let Some(t) = a.time_ms {
+                run.extend(t)?;
+            }
+            run
+        }
+        None => JetRun::new(a.params()?, a.seed)?,
+    };
+    let params = run.params().clone();
+    let seed = run.seed();
     let mut snaps = match &a.snapshots {
         Some(dir) => Some(snapshots::Snapshots::new(dir, a.snapshot_every)?),
         None => None,
@@ -124,6 +145,11 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
     // The bar counts simulated microseconds.
     let total_us = (params.time_ms * 1e3).ceil() as u64;
     let bar = progress::bar(total_us, "µs simulated", !a.json);
+    bar.set_position(
+        run.slices()
+            .last()
+            .map_or(0, |s| (s.sample.t_s * 1e6) as u64),
+    );
     let t0 = Instant::now();
     let mut failure = None;
     while !run.finished() {
@@ -160,11 +186,14 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
         if let Some(sn) = snaps.as_mut() {
             sn.write(&run)?;
         }
+        if let Some(path) = &a.checkpoint {
+            write_bytes(path, &run.checkpoint())?;
+        }
     }
     bar.finish();
     let out = JetOutput {
         params: &params,
-        seed: a.seed,
+        seed,
         series: run.slices().iter().map(|s| s.sample).collect(),
         slices: run.slices(),
         wall_s: t0.elapsed().as_secs_f64(),

@@ -43,6 +43,11 @@ fn write_atomic(
     written.with_context(|| format!("writing {}", path.display()))
 }
 
+/// Writes `bytes` to `path`, atomically.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    write_atomic(path, |w| Ok(w.write_all(bytes)?))
+}
+
 /// Writes `value` as pretty JSON with a final newline, atomically.
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
     write_atomic(path, |w| {

@@ -17,6 +17,15 @@ pub const GRIT: &str = env!("CARGO_BIN_EXE_grit");
 pub const SUBMIT: &str = "submit-token-for-tests";
 pub const WORKER: &str = "worker-token-for-tests";
 
+/// Asserts that the PNG at `path` decodes and is not blank (more than three colours).
+pub fn png_ok(path: &Path) {
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8();
+    let colours: std::collections::BTreeSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 3, "{} is blank", path.display());
+}
+
 /// The tests share two cores and time leases, so they run one at a time (a tokio mutex: the
 /// guard is held across awaits, and a failed test must not poison it for the others).
 pub static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());

@@ -169,9 +169,10 @@ pub struct Body {
     pub name: String,
     /// Deformable or rigid.
     pub kind: BodyKind,
-    /// Mass of particles deleted for damage D ≥ 1 (kg/m), the erosion measure.
+    /// Mass of particles deleted for damage D ≥ 1 (kg/m), the erosion measure; for a fluid, of
+    /// particles deleted out of its density range (`Fluid::density_range`).
     pub removed_mass_kg_m: f64,
-    /// Number of particles deleted for damage.
+    /// Number of particles deleted for damage (a fluid: out of its density range).
     pub removed_particles: u64,
 }
 

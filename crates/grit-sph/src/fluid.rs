@@ -95,6 +95,12 @@ pub struct Fluid {
     /// the default) adds none. DualSPHysics's usual value is 0.1 (docs/jet.md#the-scene).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub density_diffusion: f64,
+    /// Free particles whose density leaves [lo ρ0, hi ρ0] are deleted at the end of the step
+    /// and booked as the body's removed mass (DualSPHysics's `RhopOut`): spray that has thinned
+    /// to a fraction of water's density no longer stands for liquid, and its volume m/ρ̄ would
+    /// swamp its neighbours' sums. `None` (the default) keeps every particle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density_range: Option<[f64; 2]>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -116,6 +122,7 @@ impl Fluid {
             artificial_viscosity: ArtificialViscosity::WATER,
             min_pressure_pa: WATER_CAVITATION_GAUGE_PA,
             density_diffusion: 0.0,
+            density_range: None,
         }
     }
 
@@ -148,6 +155,14 @@ impl Fluid {
                 format!("{field}.density_diffusion"),
                 format!("must lie in [0, 1], got {}", self.density_diffusion),
             ));
+        }
+        if let Some([lo, hi]) = self.density_range {
+            if !(lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < 1.0 && hi > 1.0) {
+                return Err(InputError::new(
+                    format!("{field}.density_range"),
+                    format!("must be [lo, hi] with 0 < lo < 1 < hi, got [{lo}, {hi}]"),
+                ));
+            }
         }
         if !(self.min_pressure_pa.is_finite() && self.min_pressure_pa <= 0.0) {
             return Err(InputError::new(

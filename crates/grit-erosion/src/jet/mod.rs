@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::campaign::MaterialSpec;
 pub use feed::{grain_spacing_m, Feed};
-pub use scene::{Layout, FIXED_SIDE_LAYERS, WATER_DENSITY_DIFFUSION};
+pub use scene::{Layout, FIXED_SIDE_LAYERS, WATER_DENSITY_DIFFUSION, WATER_DENSITY_RANGE};
 
 /// Everything that defines one jet run (one sample of a jet campaign's cell); SI units except
 /// where the name says. Defaults: the paper's copper case at 500 m/s on a reduced scene
@@ -68,7 +68,7 @@ impl Default for JetParams {
             spacing_m: 50e-6,
             coupling_radius_d: 2.0,
             jet_width_m: 1e-3,
-            standoff_m: 1e-3,
+            standoff_m: 2e-3,
             target_width_m: 6e-3,
             target_depth_m: 2e-3,
             grain_diameter_m: 0.2e-3,
@@ -223,6 +223,13 @@ pub struct JetSlice {
     pub grains: usize,
     /// Grains fed into the jet so far.
     pub grains_fed: u64,
+    /// Water deleted so far for leaving its density range (`WATER_DENSITY_RANGE`), per metre
+    /// of depth (kg/m): against the water fed, what the scene's spray cut costs.
+    #[serde(default)]
+    pub water_deleted_kg_m: f64,
+    /// Water fed through the nozzle so far (kg/m).
+    #[serde(default)]
+    pub water_fed_kg_m: f64,
     /// Wall-clock seconds the slice took.
     pub wall_s: f64,
 }
@@ -320,6 +327,23 @@ impl JetRun {
         self.world.timers()
     }
 
+    /// Runs on to `time_ms` in all (a resumed run made longer); its slices so far stay, so
+    /// `time_ms` must not cut into them.
+    pub fn extend(&mut self, time_ms: f64) -> Result<(), JetError> {
+        let done_ms = self.slices.last().map_or(0.0, |s| s.sample.t_s * 1e3);
+        let mut p = self.params.clone();
+        p.time_ms = time_ms;
+        p.validate()?;
+        if time_ms < done_ms - 1e-9 || p.slices() < self.slices_done() {
+            return Err(JetError::Input(InputError::new(
+                "time_ms",
+                format!("the run has reached {done_ms} ms; it cannot end at {time_ms} ms"),
+            )));
+        }
+        self.params = p;
+        Ok(())
+    }
+
     /// Runs the next slice; returns it.
     pub fn run_next_slice(&mut self) -> Result<&JetSlice, JetError> {
         self.run_next_slice_observed(&|| false, None)?
@@ -397,6 +421,8 @@ impl JetRun {
             particles: p.len(),
             grains: w.abrasives().map_or(0, |a| a.dem.grains.len()),
             grains_fed: self.feed.fed(),
+            water_deleted_kg_m: w.bodies()[self.layout.fluid_body].removed_mass_kg_m,
+            water_fed_kg_m: w.inflows().iter().map(|i| i.mass_kg_m).sum(),
             wall_s,
         })
     }

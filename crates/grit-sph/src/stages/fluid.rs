@@ -28,6 +28,8 @@ pub(crate) struct FluidConst {
     av: ArtificialViscosity,
     /// δ c0 of the density diffusion (`Fluid::density_diffusion`; times h in the sum).
     delta_c0: f64,
+    /// The densities a free particle is kept within (`Fluid::density_range` times ρ0).
+    keep: Option<(f64, f64)>,
     /// Density up to which the EOS is evaluated: 0.9 of its singular compression, so a particle
     /// crushed beyond it gets a large finite pressure instead of a division by zero.
     rho_cap: f64,
@@ -42,6 +44,9 @@ impl FluidConst {
             nu: f.kinematic_viscosity(),
             av: f.artificial_viscosity,
             delta_c0: f.density_diffusion * f.eos.c0_m_s,
+            keep: f
+                .density_range
+                .map(|[lo, hi]| (lo * f.eos.rho0_kg_m3, hi * f.eos.rho0_kg_m3)),
             rho_cap: f.eos.rho0_kg_m3 * (1.0 + 0.9 * f.eos.singular_compression()),
         }
     }
@@ -53,6 +58,13 @@ impl FluidConst {
         self.eos
             .pressure((rho_bar / porosity).min(self.rho_cap), 0.0)
             .max(self.min_pressure)
+    }
+
+    /// Whether a free particle of density `rho_bar` has left the fluid's density range.
+    #[inline]
+    pub fn out_of_range(&self, rho_bar: f64) -> bool {
+        self.keep
+            .is_some_and(|(lo, hi)| !(lo..=hi).contains(&rho_bar))
     }
 
     /// The lowest gauge pressure the fluid sustains (its cavitation cut, Pa).

@@ -391,13 +391,22 @@ impl World {
     }
 
     /// Shepard density filter (eq. 12) every `shepard_interval` steps, deletion of particles with
-    /// D ≥ 1, and the next time step.
+    /// D ≥ 1 and of fluid particles out of their density range, and the next time step.
     fn housekeeping(&mut self, bc: &[BodyConst]) -> Result<(), SimError> {
         let every = self.settings.shepard_interval as u64;
         if every > 0 && self.steps.is_multiple_of(every) {
             self.filter_density_with(bc);
         }
-        let failed: Vec<bool> = self.particles.damage.iter().map(|&d| d >= 1.0).collect();
+        // Deleted: solids at D ≥ 1, free fluid particles outside their fluid's density range.
+        let p = &self.particles;
+        let failed: Vec<bool> = (0..p.len())
+            .map(|i| {
+                let free_fluid = bc[p.body[i] as usize]
+                    .fluid
+                    .filter(|_| p.flags[i] & crate::particles::KINEMATIC == 0);
+                p.damage[i] >= 1.0 || free_fluid.is_some_and(|f| f.out_of_range(p.rho[i]))
+            })
+            .collect();
         if failed.iter().any(|&f| f) {
             for (i, &f) in failed.iter().enumerate() {
                 if f {
