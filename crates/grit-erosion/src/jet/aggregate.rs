@@ -686,6 +686,8 @@ mod tests {
             particles: 100,
             grains: 1,
             grains_fed: k as u64,
+            water_deleted_kg_m: 0.0,
+            water_fed_kg_m: 0.0,
             wall_s: 0.5,
         }
     }

@@ -33,6 +33,8 @@ fn slice(k: u32) -> JetSlice {
         particles: 100,
         grains: 0,
         grains_fed: 0,
+        water_deleted_kg_m: 0.0,
+        water_fed_kg_m: 0.0,
         wall_s: 0.1,
     }
 }
@@ -111,7 +113,11 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
     assert!(r.results.partial, "one of two cells is done");
     assert_eq!(r.results.cells[0].samples, 1);
     let cd = r.results.cells[0].crater_depth_m.unwrap();
-    assert_eq!(cd.mean, 3.0 * 1e-5, "the one sample's depth at its last slice");
+    assert_eq!(
+        cd.mean,
+        3.0 * 1e-5,
+        "the one sample's depth at its last slice"
+    );
     assert_eq!(r.raw.unwrap()[0].slices.len(), 3);
     assert!(
         s.results(created.id, false).await.is_err(),
