@@ -408,3 +408,78 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
         png.display()
     );
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn chromium_shows_a_jet_campaign_with_its_charts() {
+    chromium();
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = start_coordinator(dir.path(), 3);
+    let api = Api::new(&coord.url);
+    // Two jet speeds, one sample of four 1 µs slices each, on the tiny jet scene.
+    let id = api
+        .submit(
+            r#"{"scene": "jet", "name": "dashboard-jet", "samples": 1, "velocity_m_s": [400, 500],
+                "spacing_m": 1e-4, "jet_width_m": 6e-4, "target_width_m": 3e-3,
+                "target_depth_m": 8e-4, "standoff_m": 6e-4, "grain_diameter_m": 2e-4,
+                "mass_flow_kg_s": 0.01, "time_ms": 0.004, "slice_ms": 0.001}"#,
+        )
+        .await;
+    let worker = start_worker(dir.path(), &coord.url, "jet-worker", &[]);
+    wait_for(
+        Duration::from_secs(120),
+        "the jet campaign done",
+        || api.campaign(&id),
+        |s| s["state"] == "done",
+    )
+    .await;
+    drop(worker);
+    let page = format!("{}/#token={SUBMIT}", coord.url);
+    let full = run_chromium(dir.path(), &page, &["--dump-dom"]);
+    let dom = full.split("<script>").next().unwrap().to_string();
+    let fail = |what: &str| -> ! {
+        panic!("the rendered page lacks {what}; DOM:\n{dom}");
+    };
+    if !dom.contains("dashboard-jet") || !dom.contains("8 / 8 slices") {
+        fail("the jet campaign and its progress in slices");
+    }
+    if dom.contains("class=\"banner error\"") {
+        fail("a page without an error banner");
+    }
+    if !dom.contains("id=\"impact-charts\" hidden") {
+        fail("the impact charts hidden");
+    }
+    let chart = |id: &str| -> String {
+        dom.split(&format!("id=\"{id}\""))
+            .nth(1)
+            .and_then(|rest| rest.split("</svg>").next())
+            .unwrap_or_else(|| fail(id))
+            .to_string()
+    };
+    if chart("jet-speed-chart").matches("class=\"point\"").count() != 2 {
+        fail("Cd against jet speed with a point per cell");
+    }
+    for id in ["jet-depth-chart", "jet-width-chart", "jet-mass-chart"] {
+        if !chart(id).contains("<polyline") {
+            fail(&format!("a line in {id}"));
+        }
+    }
+    for cell in 0..2 {
+        if chart(&format!("jet-profile-chart-{cell}"))
+            .matches("<polyline")
+            .count()
+            < 2
+        {
+            fail(&format!("profiles at several times for cell {cell}"));
+        }
+    }
+    // Four slices are too few for the stage-3 window: the note says so for each cell.
+    let note = dom
+        .split("id=\"jet-note\"")
+        .nth(1)
+        .and_then(|rest| rest.split("</div>").next())
+        .unwrap_or_else(|| fail("the stage-3 note"));
+    if note.matches("only 4 slices").count() != 2 {
+        fail("the stage-3 reason of both cells");
+    }
+}

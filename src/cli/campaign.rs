@@ -7,9 +7,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Args;
-use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::campaign::{AnySpec, Scene};
 use grit_erosion::CampaignResults;
-use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_farm::api::{AnyResults, CampaignState, CampaignStatus};
 use grit_farm::embedded::{self, EmbeddedOptions, RunEvent};
 use grit_farm::worker::Stop;
 use grit_farm::{Client, ClientError};
@@ -145,10 +145,18 @@ fn fmt_state(s: &CampaignState) -> String {
     format!("{s:?}").to_lowercase()
 }
 
+/// What a campaign of `scene` counts its progress in.
+fn unit(scene: Scene) -> &'static str {
+    match scene {
+        Scene::Impact => "impacts",
+        Scene::Jet => "slices",
+    }
+}
+
 /// `grit run`: the campaign on this machine, a progress bar, results.json and its charts.
 pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let text = read_spec_text(&a.campaign)?;
-    let spec = CampaignSpec::from_json(&text)
+    let spec = AnySpec::from_json(&text)
         .and_then(|s| s.validate().map(|_| s))
         .with_context(|| a.campaign.display().to_string())?;
     let opts = EmbeddedOptions {
@@ -162,7 +170,8 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     };
     let stop = Stop::default();
     on_signals(stop.clone());
-    let bar = progress::bar(0, "impacts", !a.quiet);
+    let units = unit(spec.scene());
+    let bar = progress::bar(0, units, !a.quiet);
     // Without a terminal (a log file, a batch job) the bar draws nothing: say the same in a
     // plain line now and then, so long campaigns still show progress.
     let plain = !a.quiet && !std::io::IsTerminal::is_terminal(&std::io::stderr());
@@ -178,7 +187,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
             if plain && last_line.is_none_or(|t| t.elapsed() >= Duration::from_secs(30)) {
                 last_line = Some(Instant::now());
                 eprintln!(
-                    "[{:>6.0} s] {}/{} impacts  {}",
+                    "[{:>6.0} s] {}/{} {units}  {}",
                     started.elapsed().as_secs_f64(),
                     status.impacts_done,
                     status.impacts_total,
@@ -197,18 +206,8 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         outcome.state,
         results_path.display()
     );
-    for c in &outcome.results.results.cells {
-        let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
-        say!(
-            "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}",
-            c.angle_deg,
-            c.shape,
-            c.samples,
-            fmt(c.erosion_mean),
-            fmt(c.erosion_std)
-        );
-    }
-    warn_unsteady(&outcome.results.results, true);
+    say_cells(&outcome.results);
+    warn_unsteady_any(&outcome.results, true);
     // Charts beside results.json (`grit plot` draws the same); a chart that fails leaves
     // the results, already written, standing.
     match grit_plot::plot_file(&results_path, &a.out) {
@@ -223,6 +222,69 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         CampaignState::Done => ExitCode::SUCCESS,
         _ => ExitCode::from(1),
     })
+}
+
+/// One line per cell of the results on stdout: erosion for impacts, Cd, Cw and mass loss at T
+/// for a jet.
+fn say_cells(results: &AnyResults) {
+    let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
+    match results {
+        AnyResults::Impact(r) => {
+            for c in &r.results.cells {
+                say!(
+                    "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}",
+                    c.angle_deg,
+                    c.shape,
+                    c.samples,
+                    fmt(c.erosion_mean),
+                    fmt(c.erosion_std)
+                );
+            }
+        }
+        AnyResults::Jet(r) => {
+            let pm = |s: &Option<grit_erosion::aggregate::Stats>, scale: f64| {
+                s.map_or("–".to_string(), |s| {
+                    format!(
+                        "{:.4} ± {}",
+                        s.mean * scale,
+                        s.std.map_or("–".into(), |d| format!("{:.4}", d * scale))
+                    )
+                })
+            };
+            for c in &r.results.cells {
+                say!(
+                    "cell {:>3}  v {:>6.1} m/s  samples {:>3}  Cd {} mm  Cw {} mm  loss {} mg/m  stage-3 {}",
+                    c.cell,
+                    c.velocity_m_s,
+                    c.samples,
+                    pm(&c.crater_depth_m, 1e3),
+                    pm(&c.crater_width_m, 1e3),
+                    pm(&c.mass_loss_kg_m, 1e6),
+                    c.stage3.slope_kg_m_s.map_or("–".to_string(), |f| format!(
+                        "{:.4e} ± {:.1e} kg/m/s",
+                        f.value, f.sem
+                    ))
+                );
+            }
+        }
+    }
+}
+
+/// [`warn_unsteady`] for results of either scene: a jet cell warns when its stage-3 slope is
+/// not steady (docs/jet-campaigns.md).
+fn warn_unsteady_any(results: &AnyResults, all: bool) {
+    match results {
+        AnyResults::Impact(r) => warn_unsteady(&r.results, all),
+        AnyResults::Jet(r) => {
+            let mut judged = r.results.clone();
+            if !all {
+                judged.cells.retain(|c| !c.partial);
+            }
+            for line in judged.unsteady_warnings() {
+                eprintln!("{line}");
+            }
+        }
+    }
 }
 
 /// Warns on stderr of every cell whose erosion is not a steady-state rate (docs/erosion.md,
@@ -254,8 +316,8 @@ fn say_last_error(s: &CampaignStatus) {
 
 async fn warn_unsteady_remote(client: &Client, id: Uuid, finished: bool) {
     match client.results_value(id, false).await {
-        Ok(v) => match serde_json::from_value::<CampaignResults>(v) {
-            Ok(r) => warn_unsteady(&r, finished),
+        Ok(v) => match serde_json::from_value::<AnyResults>(v) {
+            Ok(r) => warn_unsteady_any(&r, finished),
             Err(e) => eprintln!("steady state not checked: results not readable ({e})"),
         },
         Err(e) => eprintln!("steady state not checked: results not fetched ({e})"),
@@ -324,11 +386,12 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         } else {
             for c in list {
                 say!(
-                    "{}  {:<9}  {}/{} impacts  {}",
+                    "{}  {:<9}  {}/{} {}  {}",
                     c.id,
                     fmt_state(&c.state),
                     c.impacts_done,
                     c.impacts_total,
+                    unit(c.scene),
                     c.name.unwrap_or_default()
                 );
             }
@@ -344,11 +407,12 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         say!("{}", serde_json::to_string_pretty(&s)?);
     } else {
         say!(
-            "{}  {}  {}/{} impacts  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}",
+            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}",
             s.id,
             fmt_state(&s.state),
             s.impacts_done,
             s.impacts_total,
+            unit(s.scene),
             s.jobs.queued,
             s.jobs.leased,
             s.jobs.done,
@@ -391,7 +455,10 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
         ));
         while cells.len() < s.cells.len() {
             let c = &s.cells[cells.len()];
-            let prefix = format!("{:.1}° {}", c.angle_deg, c.shape);
+            let prefix = match s.scene {
+                Scene::Impact => format!("{:.1}° {}", c.angle_deg, c.shape),
+                Scene::Jet => format!("jet cell {} ({})", c.cell, unit(s.scene)),
+            };
             cells.push(multi.add(progress::bar(c.impacts_total, &prefix, true)));
         }
         for (bar, c) in cells.iter().zip(&s.cells) {
@@ -428,8 +495,8 @@ pub async fn results(a: ResultsArgs) -> anyhow::Result<ExitCode> {
     // After the JSON, so a reader of the terminal sees the warnings last; the `raw` field,
     // when present, is not part of `CampaignResults` and is ignored here. Results alone do
     // not say whether the campaign still runs, so only complete cells are judged.
-    match serde_json::from_value::<CampaignResults>(v) {
-        Ok(r) => warn_unsteady(&r, false),
+    match serde_json::from_value::<AnyResults>(v) {
+        Ok(r) => warn_unsteady_any(&r, false),
         Err(e) => eprintln!("steady state not checked: results not readable ({e})"),
     }
     Ok(ExitCode::SUCCESS)

@@ -102,28 +102,46 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
 
 /// Draws the charts and prints the table, the notes and the files written.
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| match a.results[0].parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        });
+    // A jet campaign's results have their own charts, drawn one file at a time.
+    if let [one] = a.results.as_slice() {
+        if let grit_plot::AnyInput::Jet(r) = grit_plot::load_any(one)? {
+            let report = grit_plot::plot_jet(&r, &out)?;
+            let mut o = std::io::stdout().lock();
+            let _ = write!(o, "{}", grit_plot::jet_summary_table(&r));
+            print_report(&mut o, &[], &report);
+            return Ok(ExitCode::SUCCESS);
+        }
+    }
     let inputs = a
         .results
         .iter()
         .map(|p| Ok((p.display().to_string(), grit_plot::load(p)?)))
         .collect::<Result<Vec<_>, grit_plot::PlotError>>()?;
     let (input, merge_notes) = grit_plot::merge(inputs)?;
-    let out = a.out.unwrap_or_else(|| match a.results[0].parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    });
     let report = grit_plot::plot(&input, &out)?;
-    // A closed stdout (piping into head) is not an error worth a panic.
     let mut o = std::io::stdout().lock();
     let _ = write!(o, "{}", grit_plot::summary_table(&input.results));
-    for n in merge_notes.iter().chain(&report.notes) {
+    print_report(&mut o, &merge_notes, &report);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The notes and the files written, after the table.
+fn print_report(o: &mut impl Write, notes: &[String], report: &grit_plot::Report) {
+    // A closed stdout (piping into head) is not an error worth a panic.
+    for n in notes.iter().chain(&report.notes) {
         let _ = writeln!(o, "note: {n}");
     }
     let _ = writeln!(o, "wrote {} files:", report.files.len());
     for f in &report.files {
         let _ = writeln!(o, "  {}", f.display());
     }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Writes `chart` as an SVG line chart with labelled axes and a legend.

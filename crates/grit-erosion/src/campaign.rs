@@ -36,8 +36,12 @@ use crate::aggregate::{CellInput, SampleInput};
 use crate::impact::ImpactParams;
 use crate::shapes::Shape;
 
+mod any;
+pub mod jet;
 mod json;
 mod plan;
+pub use any::AnySpec;
+pub use jet::{JetCampaignSpec, JetCell, JetJob, Scene};
 use json::{field_path, one_or_many, reject_unknown};
 pub use plan::{
     annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
@@ -344,9 +348,14 @@ impl CampaignSpec {
     /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
     pub fn from_json(text: &str) -> Result<CampaignSpec, SpecError> {
         let v: Value = serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))?;
-        let Value::Object(mut map) = v else {
+        let Value::Object(map) = v else {
             return Err(err("(campaign)", "must be a JSON object"));
         };
+        Self::from_map(map)
+    }
+
+    /// Parses the spec's JSON object (see [`CampaignSpec::from_json`]).
+    pub fn from_map(mut map: Map<String, Value>) -> Result<CampaignSpec, SpecError> {
         map.retain(|_, v| !v.is_null());
         reject_unknown::<CampaignSpec>(&map, "")?;
         if let Some(Value::Object(grain)) = map.get("grain") {

@@ -3,10 +3,21 @@
 
 use std::collections::BTreeMap;
 
+use grit_erosion::campaign::Scene;
+use grit_erosion::jet::JetParams;
 use grit_erosion::{CampaignResults, ImpactParams, ImpactRecord};
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use utoipa::ToSchema;
 use uuid::Uuid;
+
+mod jet;
+pub use jet::*;
+
+/// Whether `scene` is the impact scene, which the API leaves unsaid so impact answers stay as
+/// they were before jets.
+fn is_impact(scene: &Scene) -> bool {
+    *scene == Scene::Impact
+}
 
 /// Answer to `POST /campaigns`.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
@@ -53,12 +64,16 @@ pub struct CampaignSummary {
     pub name: Option<String>,
     /// Its state.
     pub state: CampaignState,
-    /// Impacts reported so far.
+    /// Impacts reported so far (slices, for a jet campaign).
     pub impacts_done: u64,
-    /// Impacts planned.
+    /// Impacts planned (slices, for a jet campaign).
     pub impacts_total: u64,
     /// Submit time, Unix milliseconds.
     pub created_ms: i64,
+    /// The scene it runs, `jet` or `impact` (left out for impact).
+    #[serde(default, skip_serializing_if = "is_impact")]
+    #[schema(value_type = Option<String>)]
+    pub scene: Scene,
 }
 
 /// Jobs per state.
@@ -139,6 +154,12 @@ pub struct CampaignStatus {
     pub last_error: Option<JobError>,
     /// Submit time, Unix milliseconds.
     pub created_ms: i64,
+    /// The scene it runs, `jet` or `impact` (left out for impact). A jet campaign counts
+    /// slices where an impact campaign counts impacts: in `impacts_done`, `impacts_total`,
+    /// `rate_impacts_per_s` and the cells' `impacts_*`.
+    #[serde(default, skip_serializing_if = "is_impact")]
+    #[schema(value_type = Option<String>)]
+    pub scene: Scene,
 }
 
 /// Job state (the `state` column of the jobs table).
@@ -324,8 +345,10 @@ pub struct Checkpoint {
     pub data_b64: String,
 }
 
-/// A leased job: everything a worker needs to run (or resume) it.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+/// A leased job: everything a worker needs to run (or resume) it. A jet job carries its run
+/// in `jet` and `params: null` on the wire (so a worker that knows no jets refuses the answer
+/// instead of running an impact); its counts are slices.
+#[derive(Debug, Clone, Deserialize, ToSchema)]
 pub struct ClaimedJob {
     /// Job id.
     pub job_id: i64,
@@ -341,19 +364,71 @@ pub struct ClaimedJob {
     pub sample: u32,
     /// Seed of the sample.
     pub seed: u64,
-    /// Impacts planned.
+    /// Impacts planned (slices, for a jet job).
     pub impacts_planned: u32,
-    /// Impacts already stored by earlier attempts.
+    /// Impacts already stored by earlier attempts (slices, for a jet job).
     pub impacts_done: u32,
-    /// The impact scene.
-    #[schema(value_type = Object)]
+    /// The impact scene; for a jet job `null` on the wire and the default scene here, unused.
+    #[schema(value_type = Option<Object>)]
+    #[serde(deserialize_with = "null_as_default")]
     pub params: ImpactParams,
+    /// The jet run, for a jet job.
+    #[serde(default)]
+    #[schema(value_type = Option<Object>)]
+    pub jet: Option<JetParams>,
     /// Whether the job's cell may later ask for more impacts (`until_steady`): then send a
     /// checkpoint after the last impact with `complete`, so the job can resume from it.
     #[serde(default)]
     pub extendable: bool,
     /// The latest checkpoint, if any.
     pub checkpoint: Option<Checkpoint>,
+}
+
+/// `null` as the type's default, any other value as itself.
+fn null_as_default<'de, D: Deserializer<'de>, T: Deserialize<'de> + Default>(
+    d: D,
+) -> Result<T, D::Error> {
+    Ok(Option::<T>::deserialize(d)?.unwrap_or_default())
+}
+
+impl Serialize for ClaimedJob {
+    /// The derived form, with `params: null` and `jet` for a jet job (`jet` left out for an
+    /// impact job, whose answer is as before jets).
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Wire<'a> {
+            job_id: i64,
+            lease_id: Uuid,
+            lease_ttl_s: f64,
+            campaign_id: Uuid,
+            cell: u32,
+            sample: u32,
+            seed: u64,
+            impacts_planned: u32,
+            impacts_done: u32,
+            params: Option<&'a ImpactParams>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            jet: Option<&'a JetParams>,
+            extendable: bool,
+            checkpoint: &'a Option<Checkpoint>,
+        }
+        Wire {
+            job_id: self.job_id,
+            lease_id: self.lease_id,
+            lease_ttl_s: self.lease_ttl_s,
+            campaign_id: self.campaign_id,
+            cell: self.cell,
+            sample: self.sample,
+            seed: self.seed,
+            impacts_planned: self.impacts_planned,
+            impacts_done: self.impacts_done,
+            params: self.jet.is_none().then_some(&self.params),
+            jet: self.jet.as_ref(),
+            extendable: self.extendable,
+            checkpoint: &self.checkpoint,
+        }
+        .serialize(s)
+    }
 }
 
 /// Heartbeat: renews the lease and delivers finished impacts and optionally a checkpoint.

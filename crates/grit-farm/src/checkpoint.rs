@@ -2,8 +2,11 @@
 //! belong to, their length and their SHA-256, and the one check both ends run on them. The
 //! coordinator refuses an upload that fails it (nothing of that request is stored), and a
 //! worker that gets a stored checkpoint failing it starts the sample again from impact 0.
+//! A jet job's checkpoints (`grit_erosion::jet::JetRun::checkpoint` bytes, counting slices)
+//! go through the same envelope checks ([`verify_jet`]).
 
 use base64::Engine;
+use grit_erosion::jet::{JetError, JetParams, JetRun};
 use grit_erosion::{ImpactParams, Sample, SampleError};
 use sha2::{Digest, Sha256};
 
@@ -29,6 +32,11 @@ impl Checkpoint {
     /// The envelope of `sample`'s state now, as job `job_id`.
     pub fn of_sample(job_id: i64, sample: &Sample) -> Checkpoint {
         Checkpoint::from_bytes(job_id, sample.impacts_done(), &sample.checkpoint())
+    }
+
+    /// The envelope of jet run `run`'s state after its last finished slice, as job `job_id`.
+    pub fn of_jet(job_id: i64, run: &JetRun) -> Checkpoint {
+        Checkpoint::from_bytes(job_id, run.slices_done(), &run.checkpoint())
     }
 }
 
@@ -95,6 +103,107 @@ pub fn verify_upload(
     params: &ImpactParams,
     seed: u64,
 ) -> Result<(Sample, CheckpointBytes), CheckpointError> {
+    let (bytes, actual) = envelope(c, job_id)?;
+    let sample = Sample::resume(params, seed, &bytes).map_err(|e| {
+        let rule = match e {
+            // Its text starts with "checkpoint: " already.
+            SampleError::Checkpoint(_) => e.to_string(),
+            other => format!("checkpoint: {other}"),
+        };
+        refuse("checkpoint.data_b64", rule)
+    })?;
+    if sample.impacts_done() != c.impacts_done {
+        return Err(refuse(
+            "checkpoint.impacts_done",
+            format!(
+                "is {} but the checkpoint holds {} impacts",
+                c.impacts_done,
+                sample.impacts_done()
+            ),
+        ));
+    }
+    let bytes = CheckpointBytes {
+        impacts_done: c.impacts_done,
+        bytes,
+        sha256: actual,
+    };
+    Ok((sample, bytes))
+}
+
+/// [`verify`] for a jet job: `c` as job `job_id`'s checkpoint of the jet run `params` seeded
+/// `seed`, its `impacts_done` counting slices; returns the run it resumes. The envelope checks
+/// are [`verify`]'s; the bytes must decode as a `JetRun` checkpoint of this build, of this run
+/// and seed, holding `impacts_done` slices.
+pub fn verify_jet(
+    c: &Checkpoint,
+    job_id: i64,
+    params: &JetParams,
+    seed: u64,
+) -> Result<JetRun, CheckpointError> {
+    verify_jet_upload(c, job_id, params, seed).map(|(run, _)| run)
+}
+
+/// [`verify_jet`], also handing back the checked bytes and their SHA-256 for the store.
+pub fn verify_jet_upload(
+    c: &Checkpoint,
+    job_id: i64,
+    params: &JetParams,
+    seed: u64,
+) -> Result<(JetRun, CheckpointBytes), CheckpointError> {
+    let (bytes, actual) = envelope(c, job_id)?;
+    let run = JetRun::resume(params, seed, &bytes).map_err(|e| {
+        let rule = match e {
+            // "checkpoint cannot decode: …", "checkpoint belongs to another run …".
+            JetError::Checkpoint(m) => format!("checkpoint: {m}"),
+            other => format!("checkpoint: {other}"),
+        };
+        refuse("checkpoint.data_b64", rule)
+    })?;
+    if run.slices_done() != c.impacts_done {
+        return Err(refuse(
+            "checkpoint.impacts_done",
+            format!(
+                "is {} but the checkpoint holds {} slices",
+                c.impacts_done,
+                run.slices_done()
+            ),
+        ));
+    }
+    let bytes = CheckpointBytes {
+        impacts_done: c.impacts_done,
+        bytes,
+        sha256: actual,
+    };
+    Ok((run, bytes))
+}
+
+/// The scene a job's checkpoints must hold.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JobParams {
+    /// An impact job's scene.
+    Impact(ImpactParams),
+    /// A jet job's run.
+    Jet(JetParams),
+}
+
+/// [`verify_upload`] or [`verify_jet_upload`] as the job's scene says, handing back only the
+/// checked bytes: what the coordinator keeps of an upload.
+pub fn verify_any_upload(
+    c: &Checkpoint,
+    job_id: i64,
+    params: &JobParams,
+    seed: u64,
+) -> Result<CheckpointBytes, CheckpointError> {
+    match params {
+        JobParams::Impact(p) => verify_upload(c, job_id, p, seed).map(|(_, b)| b),
+        JobParams::Jet(p) => verify_jet_upload(c, job_id, p, seed).map(|(_, b)| b),
+    }
+}
+
+/// The envelope checks every checkpoint passes, in order: it names job `job_id`, `data_b64`
+/// is base64 of exactly `size_bytes` bytes, and they hash to `sha256`. Returns the bytes and
+/// their SHA-256.
+fn envelope(c: &Checkpoint, job_id: i64) -> Result<(Vec<u8>, String), CheckpointError> {
     if c.job_id != job_id {
         return Err(refuse(
             "checkpoint.job_id",
@@ -145,30 +254,7 @@ pub fn verify_upload(
             format!("checkpoint checksum mismatch: the {got} bytes hash to {actual}, not {hex}"),
         ));
     }
-    let sample = Sample::resume(params, seed, &bytes).map_err(|e| {
-        let rule = match e {
-            // Its text starts with "checkpoint: " already.
-            SampleError::Checkpoint(_) => e.to_string(),
-            other => format!("checkpoint: {other}"),
-        };
-        refuse("checkpoint.data_b64", rule)
-    })?;
-    if sample.impacts_done() != c.impacts_done {
-        return Err(refuse(
-            "checkpoint.impacts_done",
-            format!(
-                "is {} but the checkpoint holds {} impacts",
-                c.impacts_done,
-                sample.impacts_done()
-            ),
-        ));
-    }
-    let bytes = CheckpointBytes {
-        impacts_done: c.impacts_done,
-        bytes,
-        sha256: actual,
-    };
-    Ok((sample, bytes))
+    Ok((bytes, actual))
 }
 
 #[cfg(test)]
@@ -217,6 +303,50 @@ mod tests {
         let (_, kept) = verify_upload(&upper, 7, &params, 3).unwrap();
         assert_eq!(kept, CheckpointBytes::new(0, bytes));
         assert_eq!(kept.sha256, c.sha256);
+    }
+
+    /// The lead's small jet scene (crates/grit-erosion/tests/jet.rs), one slice of 1 µs.
+    fn tiny_jet() -> JetParams {
+        JetParams {
+            spacing_m: 1e-4,
+            jet_width_m: 6e-4,
+            target_width_m: 3e-3,
+            target_depth_m: 8e-4,
+            standoff_m: 6e-4,
+            grain_diameter_m: 2e-4,
+            mass_flow_kg_s: 0.01,
+            time_ms: 0.002,
+            slice_ms: 0.001,
+            ..JetParams::default()
+        }
+    }
+
+    #[test]
+    fn a_jet_checkpoint_resumes_its_run_and_only_its_own() {
+        let p = tiny_jet();
+        let run = JetRun::new(p.clone(), 5).unwrap();
+        let c = Checkpoint::of_jet(7, &run);
+        let back = verify_jet(&c, 7, &p, 5).unwrap();
+        assert_eq!(back.checkpoint(), run.checkpoint());
+        let kept = verify_any_upload(&c, 7, &JobParams::Jet(p.clone()), 5).unwrap();
+        assert_eq!(kept.bytes, run.checkpoint());
+        let e = verify_jet(&c, 7, &p, 6).unwrap_err();
+        assert_eq!(e.field, "checkpoint.data_b64");
+        assert!(e.rule.contains("belongs to another run"), "{e}");
+        assert_eq!(
+            verify_jet(&c, 8, &p, 5).unwrap_err().field,
+            "checkpoint.job_id"
+        );
+        let count = Checkpoint {
+            impacts_done: 1,
+            ..c.clone()
+        };
+        let e = verify_jet(&count, 7, &p, 5).unwrap_err();
+        assert_eq!(e.rule, "is 1 but the checkpoint holds 0 slices");
+        // An impact checkpoint is no jet checkpoint, and the other way round.
+        let (ip, ic, _) = good();
+        assert!(verify_any_upload(&ic, 7, &JobParams::Jet(p), 3).is_err());
+        assert!(verify_any_upload(&c, 7, &JobParams::Impact(ip), 5).is_err());
     }
 
     #[test]

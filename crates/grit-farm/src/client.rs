@@ -248,4 +248,36 @@ impl Client {
         self.post_empty(&format!("/worker/jobs/{job}/release"), req)
             .await
     }
+
+    /// Renews a jet job's lease, delivering slices and maybe a checkpoint.
+    pub async fn heartbeat_jet(
+        &self,
+        job: i64,
+        req: &JetHeartbeatRequest,
+    ) -> Result<HeartbeatResponse, ClientError> {
+        self.post(&format!("/worker/jobs/{job}/heartbeat"), req)
+            .await
+    }
+
+    /// Completes a jet job.
+    pub async fn complete_jet(
+        &self,
+        job: i64,
+        req: &JetCompleteRequest,
+    ) -> Result<(), ClientError> {
+        self.post_empty(&format!("/worker/jobs/{job}/complete"), req)
+            .await
+    }
+
+    /// Reports a failed attempt at a jet job.
+    pub async fn fail_jet(&self, job: i64, req: &JetFailRequest) -> Result<(), ClientError> {
+        self.post_empty(&format!("/worker/jobs/{job}/fail"), req)
+            .await
+    }
+
+    /// Gives a jet job back.
+    pub async fn release_jet(&self, job: i64, req: &JetReleaseRequest) -> Result<(), ClientError> {
+        self.post_empty(&format!("/worker/jobs/{job}/release"), req)
+            .await
+    }
 }

@@ -1,14 +1,15 @@
 //! The embedded mode behind `grit run`: a coordinator on a SQLite file in the output folder and
 //! N local workers in one process, run until the campaign ends; progress is reported through a
 //! callback and the results are returned. Running it again on the same folder with the same
-//! campaign resumes where it stopped (the submit is idempotent on the spec).
+//! campaign resumes where it stopped (the submit is idempotent on the spec). Campaigns of
+//! either scene run so.
 
 use std::path::PathBuf;
 use std::time::Duration;
 
-use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::campaign::{AnySpec, CampaignSpec};
 
-use crate::api::{CampaignState, CampaignStatus, ResultsResponse};
+use crate::api::{AnyResults, CampaignState, CampaignStatus};
 use crate::client::{Client, ClientError};
 use crate::db::Store;
 use crate::server::{self, Config, Secret};
@@ -23,7 +24,7 @@ pub struct EmbeddedOptions {
     pub workers: usize,
     /// Engine threads per worker; `None` splits the machine's cores among the workers.
     pub threads_per_worker: Option<usize>,
-    /// Checkpoint every this many impacts.
+    /// Checkpoint every this many impacts (a jet job checkpoints after every slice).
     pub checkpoint_every: u32,
     /// Include every sample's per-impact series in the results (as `?raw=true`).
     pub raw: bool,
@@ -50,7 +51,7 @@ pub struct EmbeddedOutcome {
     /// Final state of the campaign (not final when stopped from outside).
     pub state: CampaignState,
     /// The results, as the results endpoint serves them.
-    pub results: ResultsResponse,
+    pub results: AnyResults,
 }
 
 /// Why the embedded run could not go on.
@@ -96,6 +97,11 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 /// The idempotency key under which `grit run` stores `spec` in its database, so running the
 /// same spec again continues the same campaign.
 pub fn campaign_key(spec: &CampaignSpec) -> Result<String, serde_json::Error> {
+    any_campaign_key(&AnySpec::Impact(spec.clone()))
+}
+
+/// [`campaign_key`] for a spec of either scene; an impact spec's key is the same.
+pub fn any_campaign_key(spec: &AnySpec) -> Result<String, serde_json::Error> {
     let spec_json = serde_json::to_string(spec)?;
     Ok(format!("grit-run:{:016x}", fnv1a(spec_json.as_bytes())))
 }
@@ -103,7 +109,7 @@ pub fn campaign_key(spec: &CampaignSpec) -> Result<String, serde_json::Error> {
 /// Runs `spec` to the end (or until `stop`) and returns its results; `on_event` hears of the
 /// start, every status poll and anything worth a line.
 pub async fn run(
-    spec: &CampaignSpec,
+    spec: &AnySpec,
     opts: &EmbeddedOptions,
     stop: Stop,
     mut on_event: impl FnMut(RunEvent<'_>),
@@ -121,8 +127,8 @@ pub async fn run(
         })?;
     // Nothing else uses this file, so leases left by an interrupted run are dead.
     store.requeue_all_leases().await?;
-    let key = campaign_key(spec)?;
-    let created = store.create_campaign(spec, Some(&key)).await?;
+    let key = any_campaign_key(spec)?;
+    let created = store.create_any(spec, Some(&key)).await?;
     if !created.created {
         // Running again continues the campaign. Jobs that failed here mostly lost their lease
         // while the whole process was stopped or the machine slept (its own workers could not
@@ -193,7 +199,7 @@ pub async fn run(
             Err(e) => on_event(RunEvent::Note(format!("worker panicked: {e}"))),
         }
     }
-    let results = store.results(created.id, opts.raw).await?;
+    let results = store.results_any(created.id, opts.raw).await?;
     running.stop().await;
     Ok(EmbeddedOutcome { state, results })
 }

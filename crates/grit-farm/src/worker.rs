@@ -1,7 +1,8 @@
 //! The worker loop: claim a job, run its impacts in order (each in a blocking thread, rayon
 //! inside the engine), report every finished impact by heartbeat, upload a checkpoint every K
 //! impacts, complete. On stop it abandons the running impact through the engine's cancel
-//! callback, uploads a checkpoint and releases the lease.
+//! callback, uploads a checkpoint and releases the lease. A jet job runs slice by slice
+//! instead (`jet`), with a checkpoint after every slice.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -14,6 +15,8 @@ use crate::api::{
 };
 use crate::checkpoint::verify;
 use crate::client::{Client, ClientError};
+
+mod jet;
 
 /// A stop request shared by a signal handler, the async loop and the engine's cancel callback.
 #[derive(Clone)]
@@ -104,6 +107,8 @@ pub struct WorkerSummary {
     pub jobs_done: u64,
     /// Impacts simulated.
     pub impacts: u64,
+    /// Jet slices simulated.
+    pub slices: u64,
 }
 
 /// A failure that stops the worker (bad token, an answer it cannot understand).
@@ -218,6 +223,9 @@ impl Runner {
     }
 
     async fn run_job(&mut self, job: ClaimedJob) -> JobEnd {
+        if let Some(params) = job.jet.clone() {
+            return self.run_jet_job(job, params).await;
+        }
         let mut sample = match Self::open_sample(&job) {
             Ok(s) => s,
             Err(e) => {
@@ -449,6 +457,7 @@ mod tests {
             impacts_planned: 3,
             impacts_done: sample.impacts_done(),
             params: sample.params().clone(),
+            jet: None,
             extendable: false,
             checkpoint,
         }

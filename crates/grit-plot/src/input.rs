@@ -1,7 +1,9 @@
-//! The results JSON: grit-erosion's `CampaignResults` with the farm's optional `raw` array.
+//! The results JSON: grit-erosion's `CampaignResults` with the farm's optional `raw` array, or
+//! a jet campaign's `JetCampaignResults` (`"scene": "jet"`).
 
 use std::path::Path;
 
+use grit_erosion::jet::aggregate::JetCampaignResults;
 use grit_erosion::CampaignResults;
 use serde::Deserialize;
 use serde_json::Value;
@@ -49,6 +51,44 @@ pub fn load(path: &Path) -> Result<PlotInput, PlotError> {
     parse(&text).map_err(|e| PlotError::Input(format!("{}: {e}", path.display())))
 }
 
+/// A results file of either scene, ready to plot.
+#[derive(Debug, Clone)]
+pub enum AnyInput {
+    /// An impact campaign's results.
+    Impact(PlotInput),
+    /// A jet campaign's results (their `raw` slices, if any, are not needed by its charts).
+    Jet(JetCampaignResults),
+}
+
+/// Reads and checks a results JSON file of either scene.
+pub fn load_any(path: &Path) -> Result<AnyInput, PlotError> {
+    let text = std::fs::read_to_string(path).map_err(|error| PlotError::Read {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    parse_any(&text).map_err(|e| PlotError::Input(format!("{}: {e}", path.display())))
+}
+
+/// Parses and checks results JSON text of either scene: `"scene": "jet"` marks a jet
+/// campaign's.
+pub fn parse_any(text: &str) -> Result<AnyInput, PlotError> {
+    let value: Value =
+        serde_json::from_str(text).map_err(|e| PlotError::Input(format!("not valid JSON: {e}")))?;
+    if value.get("scene").and_then(Value::as_str) != Some("jet") {
+        return parse(text).map(AnyInput::Impact);
+    }
+    let mut value = value;
+    if let Some(obj) = value.as_object_mut() {
+        obj.remove("raw");
+    }
+    let r: JetCampaignResults = serde_json::from_value(value)
+        .map_err(|e| PlotError::Input(format!("not jet results grit can read: {e}")))?;
+    if r.cells.is_empty() {
+        return Err(PlotError::Input("`cells` is empty: nothing to plot".into()));
+    }
+    Ok(AnyInput::Jet(r))
+}
+
 /// Parses and checks results JSON text.
 pub fn parse(text: &str) -> Result<PlotInput, PlotError> {
     let bad = |m: String| PlotError::Input(m);
@@ -61,6 +101,12 @@ pub fn parse(text: &str) -> Result<PlotInput, PlotError> {
             "expected a JSON object with `cells` (the results of grit run or grit results)".into(),
         ));
     };
+    if obj.get("scene").and_then(Value::as_str) == Some("jet") {
+        return Err(bad(
+            "a jet campaign's results (scene: jet), not an impact campaign's: grit plot draws              them one file at a time"
+                .into(),
+        ));
+    }
     match obj.get("cells") {
         None => {
             return Err(bad(

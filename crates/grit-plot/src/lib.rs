@@ -8,6 +8,9 @@
 //! `CampaignResults`, plus the optional `raw` per-impact series) and knows nothing of the
 //! farm, so the farm's `grit run` and the `grit plot` command share it. Text is drawn with
 //! DejaVu Sans embedded in the binary: no system font is needed.
+//!
+//! A jet campaign's results (`"scene": "jet"`) get their own charts (`jet`): crater profiles
+//! over time, Cd, Cw and mass loss against time, and Cd against the jet speed.
 #![warn(missing_docs)]
 
 mod analysis;
@@ -15,6 +18,7 @@ mod charts;
 mod draw;
 mod fonts;
 mod input;
+mod jet;
 mod jet_picture;
 mod stability;
 mod surface;
@@ -26,7 +30,10 @@ use grit_erosion::CampaignResults;
 
 pub use draw::colour;
 pub use fonts::register_fonts;
-pub use input::{load, merge, parse, PlotInput, RawImpact, RawSeries};
+pub use input::{
+    load, load_any, merge, parse, parse_any, AnyInput, PlotInput, RawImpact, RawSeries,
+};
+pub use jet::{jet_summary_table, plot_jet};
 pub use jet_picture::{jet_png, JetField, JetPicture};
 pub use stability::stability_chart;
 pub use surface::{surface_png, viridis, SurfaceField, SurfacePicture};
@@ -88,9 +95,12 @@ pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
     Ok(report)
 }
 
-/// Reads a results JSON file and writes its charts into `out`.
+/// Reads a results JSON file of either scene and writes its charts into `out`.
 pub fn plot_file(results: &Path, out: &Path) -> Result<Report, PlotError> {
-    plot(&load(results)?, out)
+    match load_any(results)? {
+        AnyInput::Impact(input) => plot(&input, out),
+        AnyInput::Jet(r) => plot_jet(&r, out),
+    }
 }
 
 /// A short table of the cells: angle, shape, samples, erosion mean ± std.

@@ -6,6 +6,7 @@
 //! each slice the crater is measured and the whole state can be checkpointed, so a killed run
 //! loses at most one slice.
 
+pub mod aggregate;
 mod feed;
 mod scene;
 

@@ -3,22 +3,40 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::campaign::{AnySpec, CampaignSpec, Scene};
 use grit_erosion::{aggregate_campaign, Impact, ImpactRecord, SampleInput};
 use sqlx::Row;
 use uuid::Uuid;
 
 use super::{insert_queued_jobs, now_ms, parse_uuid, NewJob, Store};
 use crate::api::{
-    CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress, JobCounts,
-    JobError, JobInfo, JobState, RawSample, ResultsResponse,
+    AnyResults, CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress,
+    JobCounts, JobError, JobInfo, JobState, RawSample, ResultsResponse,
 };
 use crate::error::{Error, Result};
 
 /// Window over which the impact rate (and so the ETA) is measured.
 const RATE_WINDOW_MS: i64 = 120_000;
 
+/// The scene stored in a campaign row's `scene` column.
+fn scene_of(r: &sqlx::sqlite::SqliteRow) -> Scene {
+    Scene::parse(&r.get::<String, _>("scene")).unwrap_or_default()
+}
+
 impl Store {
+    /// Stores a campaign of either scene ([`Store::create_campaign`],
+    /// [`Store::create_jet_campaign`]).
+    pub async fn create_any(
+        &self,
+        spec: &AnySpec,
+        idempotency_key: Option<&str>,
+    ) -> Result<CampaignCreated> {
+        match spec {
+            AnySpec::Impact(s) => self.create_campaign(s, idempotency_key).await,
+            AnySpec::Jet(s) => self.create_jet_campaign(s, idempotency_key).await,
+        }
+    }
+
     /// Validates, expands and stores a campaign with all its jobs in one transaction. With an
     /// idempotency key already used, returns the earlier campaign instead.
     pub async fn create_campaign(
@@ -33,26 +51,15 @@ impl Store {
         let jobs_total = cells.len() as u64 * samples as u64;
         let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
         let mut tx = self.begin().await?;
-        if let Some(key) = idempotency_key {
-            let row = sqlx::query("SELECT id, spec FROM campaigns WHERE idempotency_key = ?")
-                .bind(key)
-                .fetch_optional(&mut *tx)
-                .await?;
-            if let Some(row) = row {
-                let id: String = row.get("id");
-                let old: String = row.get("spec");
-                if old != spec_json {
-                    return Err(Error::Conflict(
-                        "Idempotency-Key already used for a different campaign".into(),
-                    ));
-                }
-                return Ok(CampaignCreated {
-                    id: parse_uuid(&id)?,
-                    jobs: jobs_total,
-                    impacts_total,
-                    created: false,
-                });
-            }
+        if let Some(id) =
+            super::jet::by_idempotency_key(&mut tx, idempotency_key, &spec_json).await?
+        {
+            return Ok(CampaignCreated {
+                id,
+                jobs: jobs_total,
+                impacts_total,
+                created: false,
+            });
         }
         let id = Uuid::new_v4();
         let now = now_ms();
@@ -123,7 +130,7 @@ impl Store {
     /// Every campaign, newest first, with state and progress.
     pub async fn list_campaigns(&self) -> Result<Vec<CampaignSummary>> {
         let rows = sqlx::query(
-            "SELECT c.id, c.name, c.impacts_total, c.created_ms, c.cancelled_ms,
+            "SELECT c.id, c.name, c.impacts_total, c.created_ms, c.cancelled_ms, c.scene,
                     COALESCE(SUM(j.impacts_done), 0) AS done,
                     COALESCE(SUM(j.state = 'queued'), 0) AS queued,
                     COALESCE(SUM(j.state = 'leased'), 0) AS leased,
@@ -157,6 +164,7 @@ impl Store {
                     impacts_done,
                     impacts_total: r.get::<i64, _>("impacts_total") as u64,
                     created_ms: r.get("created_ms"),
+                    scene: scene_of(r),
                 })
             })
             .collect()
@@ -219,11 +227,20 @@ impl Store {
         let impacts_done: u64 = cells.iter().map(|c| c.impacts_done).sum();
         let impacts_total = c.get::<i64, _>("impacts_total") as u64;
         let now = now_ms();
-        let recent = sqlx::query(
-            "SELECT COUNT(*) AS n, MIN(i.created_ms) AS first FROM impacts i
-             JOIN jobs j ON j.id = i.job_id
-             WHERE j.campaign_id = ? AND i.created_ms > ?",
-        )
+        let scene = scene_of(&c);
+        // A jet campaign's rate counts slices.
+        let recent = sqlx::query(match scene {
+            Scene::Impact => {
+                "SELECT COUNT(*) AS n, MIN(i.created_ms) AS first FROM impacts i
+                 JOIN jobs j ON j.id = i.job_id
+                 WHERE j.campaign_id = ? AND i.created_ms > ?"
+            }
+            Scene::Jet => {
+                "SELECT COUNT(*) AS n, MIN(s.created_ms) AS first FROM slices s
+                 JOIN jobs j ON j.id = s.job_id
+                 WHERE j.campaign_id = ? AND s.created_ms > ?"
+            }
+        })
         .bind(&ids)
         .bind(now - RATE_WINDOW_MS)
         .fetch_one(&self.read)
@@ -272,12 +289,34 @@ impl Store {
             cells,
             last_error,
             created_ms: c.get("created_ms"),
+            scene,
         })
     }
 
-    /// Aggregated results (partial while jobs remain); with `raw`, every sample's series.
+    /// Aggregated results of a campaign of either scene (partial while jobs remain); with
+    /// `raw`, every sample's impacts or slices.
+    pub async fn results_any(&self, id: Uuid, raw: bool) -> Result<AnyResults> {
+        let c = self.campaign_row(id).await?;
+        match scene_of(&c) {
+            Scene::Impact => Ok(AnyResults::Impact(self.results(id, raw).await?)),
+            Scene::Jet => {
+                let spec_text: String = c.get("spec");
+                Ok(AnyResults::Jet(
+                    self.jet_results(id, &spec_text, raw).await?,
+                ))
+            }
+        }
+    }
+
+    /// Aggregated results of an impact campaign (partial while jobs remain); with `raw`, every
+    /// sample's series. A jet campaign's are [`Store::results_any`]'s.
     pub async fn results(&self, id: Uuid, raw: bool) -> Result<ResultsResponse> {
         let c = self.campaign_row(id).await?;
+        if scene_of(&c) == Scene::Jet {
+            return Err(Error::Conflict(format!(
+                "campaign {id} runs the jet scene: its results are jet results"
+            )));
+        }
         let spec_text: String = c.get("spec");
         let spec = CampaignSpec::from_json(&spec_text)?;
         let cells = spec.cells()?;

@@ -21,8 +21,7 @@ use uuid::Uuid;
 
 use super::now_ms;
 use super::worker::{
-    apply_claim, apply_complete, apply_fail, apply_heartbeat, apply_release, reap, Leased,
-    NewImpact,
+    apply_claim, apply_complete, apply_fail, apply_heartbeat, apply_release, reap, Leased, NewUnits,
 };
 use crate::api::HeartbeatResponse;
 use crate::checkpoint::CheckpointBytes;
@@ -35,7 +34,7 @@ const MAX_GROUP: usize = 512;
 const QUEUE: usize = 4096;
 
 /// A lease holder's write, owned so it can wait in the queue and be applied again alone. It
-/// comes ready to store (records serialised, checkpoint decoded and hashed, error message
+/// comes ready to store (impact or slice records serialised, checkpoint decoded and hashed, error message
 /// cut to length), so the writer spends its time on the database alone.
 pub(super) enum Op {
     Claim {
@@ -44,25 +43,25 @@ pub(super) enum Op {
     Heartbeat {
         job_id: i64,
         lease: Uuid,
-        impacts: Vec<NewImpact>,
+        units: NewUnits,
         checkpoint: Option<CheckpointBytes>,
     },
     Complete {
         job_id: i64,
         lease: Uuid,
-        impacts: Vec<NewImpact>,
+        units: NewUnits,
         checkpoint: Option<CheckpointBytes>,
     },
     Fail {
         job_id: i64,
         lease: Uuid,
         error: String,
-        impacts: Vec<NewImpact>,
+        units: NewUnits,
     },
     Release {
         job_id: i64,
         lease: Uuid,
-        impacts: Vec<NewImpact>,
+        units: NewUnits,
         checkpoint: Option<CheckpointBytes>,
     },
 }
@@ -223,37 +222,35 @@ async fn apply(
         Op::Heartbeat {
             job_id,
             lease,
-            impacts,
+            units,
             checkpoint,
         } => Reply::Beat(
-            apply_heartbeat(tx, lease_ttl, *job_id, *lease, impacts, checkpoint.as_ref()).await?,
+            apply_heartbeat(tx, lease_ttl, *job_id, *lease, units, checkpoint.as_ref()).await?,
         ),
         Op::Complete {
             job_id,
             lease,
-            impacts,
+            units,
             checkpoint,
         } => {
-            apply_complete(tx, *job_id, *lease, impacts, checkpoint.as_ref()).await?;
+            apply_complete(tx, *job_id, *lease, units, checkpoint.as_ref()).await?;
             Reply::Done
         }
         Op::Fail {
             job_id,
             lease,
             error,
-            impacts,
+            units,
         } => {
-            apply_fail(tx, *job_id, *lease, error, impacts).await?;
+            apply_fail(tx, *job_id, *lease, error, units).await?;
             Reply::Done
         }
         Op::Release {
             job_id,
             lease,
-            impacts,
+            units,
             checkpoint,
-        } => {
-            Reply::Released(apply_release(tx, *job_id, *lease, impacts, checkpoint.as_ref()).await?)
-        }
+        } => Reply::Released(apply_release(tx, *job_id, *lease, units, checkpoint.as_ref()).await?),
     })
 }
 

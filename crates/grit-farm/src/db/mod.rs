@@ -22,13 +22,18 @@ mod campaigns;
 mod checkpoints;
 mod extend;
 mod group;
+mod jet;
 mod worker;
 mod workers;
+
+pub use worker::Reported;
 
 #[cfg(test)]
 mod extend_tests;
 #[cfg(test)]
 mod group_tests;
+#[cfg(test)]
+mod jet_tests;
 #[cfg(test)]
 mod tests;
 

@@ -5,11 +5,13 @@
 //! That writer is the farm's bottleneck, so what needs no database is done by the caller
 //! before or after it: impact records are serialised and checkpoints decoded and hashed
 //! before a request is queued, and a lease's scene is parsed and its checkpoint encoded
-//! after the claim has committed.
+//! after the claim has committed. A jet job's lease holder reports slices, stored in their own
+//! table, where an impact job's reports impacts; the rules are the same.
 
 use std::time::Duration;
 
 use base64::Engine;
+use grit_erosion::jet::{JetParams, JetSlice};
 use grit_erosion::{ImpactParams, ImpactRecord};
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
@@ -67,6 +69,8 @@ pub(super) struct Leased {
     done: i64,
     /// `cells.params`: the scene as JSON.
     params: String,
+    /// `campaigns.scene`: `impact` or `jet`.
+    scene: String,
     extendable: bool,
     checkpoint: Option<StoredCheckpoint>,
 }
@@ -75,8 +79,14 @@ impl Leased {
     /// The claim's answer: the scene parsed and the checkpoint enveloped.
     fn claimed(self) -> Result<ClaimedJob> {
         let job_id = self.job_id;
-        let params: ImpactParams = serde_json::from_str(&self.params)
-            .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
+        let bad =
+            |e: serde_json::Error| Error::Internal(format!("stored params of job {job_id}: {e}"));
+        let (params, jet) = if self.scene == "jet" {
+            let jet: JetParams = serde_json::from_str(&self.params).map_err(bad)?;
+            (ImpactParams::default(), Some(jet))
+        } else {
+            (serde_json::from_str(&self.params).map_err(bad)?, None)
+        };
         Ok(ClaimedJob {
             job_id,
             lease_id: self.lease,
@@ -88,6 +98,7 @@ impl Leased {
             impacts_planned: self.planned as u32,
             impacts_done: self.done as u32,
             params,
+            jet,
             extendable: self.extendable,
             checkpoint: self.checkpoint.map(|c| c.envelope(job_id)),
         })
@@ -117,6 +128,73 @@ fn serialised(impacts: &[ImpactRecord]) -> Result<Vec<NewImpact>> {
             })
         })
         .collect()
+}
+
+/// A jet slice to store, serialised before it is queued (its profile included).
+pub(super) struct NewSlice {
+    slice: u32,
+    t_s: f64,
+    mass_loss_kg_m: f64,
+    /// The whole `JetSlice` as JSON, with round-trip float formatting.
+    json: String,
+}
+
+/// `slices` ready to store.
+fn serialised_slices(slices: &[JetSlice]) -> Result<Vec<NewSlice>> {
+    slices
+        .iter()
+        .map(|s| {
+            Ok(NewSlice {
+                slice: s.slice,
+                t_s: s.sample.t_s,
+                mass_loss_kg_m: s.sample.mass_loss_kg_m,
+                json: serde_json::to_string(s).map_err(|e| Error::Internal(e.to_string()))?,
+            })
+        })
+        .collect()
+}
+
+/// What a lease holder reports with a write: the finished impacts of an impact job, or the
+/// finished slices of a jet job (the other one empty).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Reported<'a> {
+    /// Impacts, for an impact job.
+    pub impacts: &'a [ImpactRecord],
+    /// Slices, for a jet job.
+    pub slices: &'a [JetSlice],
+}
+
+impl<'a> Reported<'a> {
+    /// Impacts of an impact job.
+    pub fn impacts(impacts: &'a [ImpactRecord]) -> Self {
+        Reported {
+            impacts,
+            slices: &[],
+        }
+    }
+
+    /// Slices of a jet job.
+    pub fn slices(slices: &'a [JetSlice]) -> Self {
+        Reported {
+            impacts: &[],
+            slices,
+        }
+    }
+}
+
+/// A report ready to store: records serialised before the writer sees them.
+pub(super) struct NewUnits {
+    pub impacts: Vec<NewImpact>,
+    pub slices: Vec<NewSlice>,
+}
+
+impl NewUnits {
+    fn of(r: Reported<'_>) -> Result<NewUnits> {
+        Ok(NewUnits {
+            impacts: serialised(r.impacts)?,
+            slices: serialised_slices(r.slices)?,
+        })
+    }
 }
 
 /// A lease holder's write so far.
@@ -182,10 +260,22 @@ impl Store {
         impacts: &[ImpactRecord],
         checkpoint: Option<CheckpointBytes>,
     ) -> Result<HeartbeatResponse> {
+        self.heartbeat_with(job_id, lease, Reported::impacts(impacts), checkpoint)
+            .await
+    }
+
+    /// [`Store::heartbeat`] for either scene: impacts of an impact job, slices of a jet job.
+    pub async fn heartbeat_with(
+        &self,
+        job_id: i64,
+        lease: Uuid,
+        reported: Reported<'_>,
+        checkpoint: Option<CheckpointBytes>,
+    ) -> Result<HeartbeatResponse> {
         let op = Op::Heartbeat {
             job_id,
             lease,
-            impacts: serialised(impacts)?,
+            units: NewUnits::of(reported)?,
             checkpoint,
         };
         match self.group.apply(op).await? {
@@ -204,10 +294,22 @@ impl Store {
         impacts: &[ImpactRecord],
         checkpoint: Option<CheckpointBytes>,
     ) -> Result<()> {
+        self.complete_with(job_id, lease, Reported::impacts(impacts), checkpoint)
+            .await
+    }
+
+    /// [`Store::complete`] for either scene; a jet job must then have every planned slice.
+    pub async fn complete_with(
+        &self,
+        job_id: i64,
+        lease: Uuid,
+        reported: Reported<'_>,
+        checkpoint: Option<CheckpointBytes>,
+    ) -> Result<()> {
         let op = Op::Complete {
             job_id,
             lease,
-            impacts: serialised(impacts)?,
+            units: NewUnits::of(reported)?,
             checkpoint,
         };
         self.group.apply(op).await.map(drop)
@@ -221,11 +323,23 @@ impl Store {
         error: &str,
         impacts: &[ImpactRecord],
     ) -> Result<()> {
+        self.fail_with(job_id, lease, error, Reported::impacts(impacts))
+            .await
+    }
+
+    /// [`Store::fail`] for either scene.
+    pub async fn fail_with(
+        &self,
+        job_id: i64,
+        lease: Uuid,
+        error: &str,
+        reported: Reported<'_>,
+    ) -> Result<()> {
         let op = Op::Fail {
             job_id,
             lease,
             error: error.chars().take(MAX_ERROR_CHARS).collect(),
-            impacts: serialised(impacts)?,
+            units: NewUnits::of(reported)?,
         };
         self.group.apply(op).await.map(drop)
     }
@@ -238,10 +352,22 @@ impl Store {
         impacts: &[ImpactRecord],
         checkpoint: Option<CheckpointBytes>,
     ) -> Result<()> {
+        self.release_with(job_id, lease, Reported::impacts(impacts), checkpoint)
+            .await
+    }
+
+    /// [`Store::release`] for either scene.
+    pub async fn release_with(
+        &self,
+        job_id: i64,
+        lease: Uuid,
+        reported: Reported<'_>,
+        checkpoint: Option<CheckpointBytes>,
+    ) -> Result<()> {
         let op = Op::Release {
             job_id,
             lease,
-            impacts: serialised(impacts)?,
+            units: NewUnits::of(reported)?,
             checkpoint,
         };
         self.group.apply(op).await.map(drop)
@@ -293,7 +419,8 @@ pub(super) async fn apply_claim(
     let cell: i64 = r.get("cell_index");
     // The job's cell and its checkpoint, if any, in one statement.
     let c = sqlx::query(
-        "SELECT c.params, c.impacts, c.impacts_max, k.impacts_done, k.data, k.sha256
+        "SELECT c.params, c.impacts, c.impacts_max, k.impacts_done, k.data, k.sha256,
+                (SELECT scene FROM campaigns WHERE id = ?2)
          FROM cells c LEFT JOIN checkpoints k ON k.job_id = ?1
          WHERE c.campaign_id = ?2 AND c.cell_index = ?3",
     )
@@ -323,6 +450,7 @@ pub(super) async fn apply_claim(
         planned: r.get("impacts_planned"),
         done: r.get("impacts_done"),
         params: c.get(0),
+        scene: c.get(6),
         extendable,
         checkpoint,
     }))
@@ -334,10 +462,10 @@ pub(super) async fn apply_heartbeat(
     lease_ttl: Duration,
     job_id: i64,
     lease: Uuid,
-    impacts: &[NewImpact],
+    units: &NewUnits,
     checkpoint: Option<&CheckpointBytes>,
 ) -> Result<HeartbeatResponse> {
-    let Report { now, done, .. } = report(tx, job_id, lease, impacts, checkpoint).await?;
+    let Report { now, done, .. } = report(tx, job_id, lease, units, checkpoint).await?;
     let expires = now + lease_ttl.as_millis() as i64;
     sqlx::query(
         "UPDATE jobs SET lease_expires_ms = ?, impacts_done = ?, updated_ms = ? WHERE id = ?",
@@ -359,15 +487,16 @@ pub(super) async fn apply_complete(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
-    impacts: &[NewImpact],
+    units: &NewUnits,
     checkpoint: Option<&CheckpointBytes>,
 ) -> Result<()> {
-    let Report { now, held, done } = report(tx, job_id, lease, impacts, checkpoint).await?;
+    let Report { now, held, done } = report(tx, job_id, lease, units, checkpoint).await?;
     if done < held.planned {
+        let unit = held.unit();
         return Err(Error::invalid(
-            "impacts",
+            unit,
             format!(
-                "the job has {done} of its {} planned impacts; send the rest before completing",
+                "the job has {done} of its {} planned {unit}; send the rest before completing",
                 held.planned
             ),
         ));
@@ -390,9 +519,9 @@ pub(super) async fn apply_fail(
     job_id: i64,
     lease: Uuid,
     error: &str,
-    impacts: &[NewImpact],
+    units: &NewUnits,
 ) -> Result<()> {
-    let Report { now, done, .. } = report(tx, job_id, lease, impacts, None).await?;
+    let Report { now, done, .. } = report(tx, job_id, lease, units, None).await?;
     sqlx::query(
         "UPDATE jobs SET attempts = attempts + 1, impacts_done = ?, last_error = ?,
              state = CASE WHEN attempts + 1 >=
@@ -415,27 +544,43 @@ pub(super) async fn apply_release(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
-    impacts: &[NewImpact],
+    units: &NewUnits,
     checkpoint: Option<&CheckpointBytes>,
 ) -> Result<u32> {
-    let Report { now, done, .. } = report(tx, job_id, lease, impacts, checkpoint).await?;
+    let Report { now, done, .. } = report(tx, job_id, lease, units, checkpoint).await?;
     end_lease(tx, job_id, "queued", done, now).await?;
     Ok(done)
 }
 
 /// The start of a lease holder's write in `tx`: checks the lease, marks the worker seen, and
-/// stores `impacts` and then the checkpoint, if any.
+/// stores the impacts (or a jet job's slices) and then the checkpoint, if any.
 async fn report(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     lease: Uuid,
-    impacts: &[NewImpact],
+    units: &NewUnits,
     checkpoint: Option<&CheckpointBytes>,
 ) -> Result<Report> {
     let now = now_ms();
     let held = check_lease(tx, job_id, lease, now).await?;
     touch_worker(tx, held.worker.as_deref(), now).await?;
-    let done = store_impacts(tx, job_id, &held, impacts, now).await?;
+    let done = if held.jet {
+        if !units.impacts.is_empty() {
+            return Err(Error::invalid(
+                "impacts",
+                format!("job {job_id} runs the jet scene: report slices, not impacts"),
+            ));
+        }
+        store_slices(tx, job_id, &held, &units.slices, now).await?
+    } else {
+        if !units.slices.is_empty() {
+            return Err(Error::invalid(
+                "slices",
+                format!("job {job_id} runs the impact scene: report impacts, not slices"),
+            ));
+        }
+        store_impacts(tx, job_id, &held, &units.impacts, now).await?
+    };
     if let Some(c) = checkpoint {
         store_checkpoint(tx, job_id, done, c, now).await?;
     }
@@ -454,6 +599,19 @@ struct Held {
     plan: CellPlan,
     /// Whether a checkpoint of the job is stored.
     has_checkpoint: bool,
+    /// Whether the job runs the jet scene (its units are slices).
+    jet: bool,
+}
+
+impl Held {
+    /// The job's unit of progress, as its field is named.
+    fn unit(&self) -> &'static str {
+        if self.jet {
+            "slices"
+        } else {
+            "impacts"
+        }
+    }
 }
 
 async fn check_lease(
@@ -469,7 +627,8 @@ async fn check_lease(
                 k.impacts AS impacts, k.samples AS samples, k.impacts_max AS impacts_max,
                 k.impacts_step AS impacts_step, k.samples_max AS samples_max,
                 k.target_sem_rel AS target_sem_rel,
-                EXISTS (SELECT 1 FROM checkpoints c WHERE c.job_id = j.id) AS has_checkpoint
+                EXISTS (SELECT 1 FROM checkpoints c WHERE c.job_id = j.id) AS has_checkpoint,
+                (SELECT p.scene FROM campaigns p WHERE p.id = j.campaign_id) AS scene
          FROM jobs j JOIN cells k ON k.campaign_id = j.campaign_id AND k.cell_index = j.cell_index
          WHERE j.id = ?",
     )
@@ -502,6 +661,7 @@ async fn check_lease(
         cell: r.get("cell_index"),
         plan: CellPlan::from_row(&r),
         has_checkpoint: r.get("has_checkpoint"),
+        jet: r.get::<&str, _>("scene") == "jet",
     })
 }
 
@@ -600,6 +760,64 @@ async fn store_impacts(
                 .push_bind(rec.impact as i64)
                 .push_bind(rec.grain_mass_kg)
                 .push_bind(rec.mass_loss_kg)
+                .push_bind(rec.json.as_str())
+                .push_bind(now);
+        });
+        qb.build().execute(&mut **tx).await?;
+    }
+    Ok(done)
+}
+
+/// Appends a jet job's slices after those stored, by the rules of [`store_impacts`]: slices
+/// already stored are skipped, the next must be stored + 1, every record is checked before
+/// any is written. Returns the count stored afterwards.
+async fn store_slices(
+    tx: &mut Transaction<'static, Sqlite>,
+    job_id: i64,
+    held: &Held,
+    slices: &[NewSlice],
+    now: i64,
+) -> Result<u32> {
+    let mut done = held.done;
+    let mut new = Vec::with_capacity(slices.len());
+    for (i, rec) in slices.iter().enumerate() {
+        let field = |name: &str| format!("slices[{i}].{name}");
+        if rec.slice <= done {
+            continue;
+        }
+        if rec.slice != done + 1 {
+            return Err(Error::invalid(
+                field("slice"),
+                format!("expected slice {} next, got {}", done + 1, rec.slice),
+            ));
+        }
+        if rec.slice > held.planned {
+            return Err(Error::invalid(
+                field("slice"),
+                format!("the job plans only {} slices", held.planned),
+            ));
+        }
+        if !rec.t_s.is_finite() {
+            return Err(Error::invalid(field("sample.t_s"), "must be finite"));
+        }
+        if !(rec.mass_loss_kg_m.is_finite() && rec.mass_loss_kg_m >= 0.0) {
+            return Err(Error::invalid(
+                field("sample.mass_loss_kg_m"),
+                "must be finite and ≥ 0",
+            ));
+        }
+        new.push(rec);
+        done = rec.slice;
+    }
+    for chunk in new.chunks(IMPACT_ROWS_PER_INSERT) {
+        let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
+            "INSERT INTO slices (job_id, slice, t_s, mass_loss_kg_m, record, created_ms) ",
+        );
+        qb.push_values(chunk, |mut b, rec| {
+            b.push_bind(job_id)
+                .push_bind(rec.slice as i64)
+                .push_bind(rec.t_s)
+                .push_bind(rec.mass_loss_kg_m)
                 .push_bind(rec.json.as_str())
                 .push_bind(now);
         });

@@ -8,7 +8,7 @@ use axum::extract::{Path, Query, State};
 use axum::http::{HeaderMap, StatusCode};
 use axum::routing::{get, post};
 use axum::{Json, Router};
-use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::campaign::AnySpec;
 use serde::Deserialize;
 use uuid::Uuid;
 
@@ -47,7 +47,8 @@ fn campaign_id(raw: &str) -> Result<Uuid> {
         .map_err(|_| Error::NotFound(format!("campaign {raw}")))
 }
 
-/// Submits a campaign (the campaign spec of README.md and docs/api.md).
+/// Submits a campaign (the campaign spec of README.md and docs/api.md; `"scene": "jet"` for a
+/// jet campaign, docs/jet-campaigns.md).
 #[utoipa::path(post, path = "/api/v1/campaigns",
     request_body(content = Object, description = "campaign spec; every field optional"),
     params(("Idempotency-Key" = Option<String>, Header, description = "a retried submit with the same key returns the first campaign")),
@@ -63,7 +64,7 @@ async fn create_campaign(
         status: StatusCode::BAD_REQUEST,
         message: "body is not UTF-8 JSON".into(),
     })?;
-    let spec = CampaignSpec::from_json(text).map_err(|e| {
+    let spec = AnySpec::from_json(text).map_err(|e| {
         if e.field == "(json)" {
             Error::BadRequest {
                 status: StatusCode::BAD_REQUEST,
@@ -86,7 +87,7 @@ async fn create_campaign(
             "must be 1 to 200 characters",
         ));
     }
-    let created = s.store.create_campaign(&spec, key).await?;
+    let created = s.store.create_any(&spec, key).await?;
     let status = if created.created {
         StatusCode::CREATED
     } else {
@@ -119,14 +120,15 @@ struct ResultsQuery {
 }
 
 #[utoipa::path(get, path = "/api/v1/campaigns/{id}/results", params(("id" = Uuid, Path), ResultsQuery),
-    responses((status = 200, body = ResultsResponse), (status = 401), (status = 404, body = ErrorBody)),
+    responses((status = 200, body = AnyResults, description = "an impact campaign's ResultsResponse, or a jet campaign's JetResultsResponse (`scene: jet`)"),
+        (status = 401), (status = 404, body = ErrorBody)),
     security(("submit_token" = [])))]
 async fn campaign_results(
     State(s): State<AppState>,
     Path(id): Path<String>,
     Query(q): Query<ResultsQuery>,
-) -> Result<Json<ResultsResponse>> {
-    Ok(Json(s.store.results(campaign_id(&id)?, q.raw).await?))
+) -> Result<Json<AnyResults>> {
+    Ok(Json(s.store.results_any(campaign_id(&id)?, q.raw).await?))
 }
 
 /// Query of `GET /campaigns/{id}/jobs`.

@@ -2,18 +2,56 @@
 //! impacts and checkpoints), complete, fail or release the job it holds. A checkpoint is
 //! verified (`crate::checkpoint::verify_upload`) before the store sees the request, so a
 //! refused one leaves nothing of its request stored, impacts included; the store gets the
-//! bytes and checksum that check produced, and decodes nothing again.
+//! bytes and checksum that check produced, and decodes nothing again. A jet job reports
+//! `slices` where an impact job reports `impacts` (`JetHeartbeatRequest` and its kin), to the
+//! same endpoints; each body is read as the union of both forms.
 
 use axum::extract::{FromRequest, Path, Request, State};
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use axum::routing::post;
 use axum::{Json, Router};
+use grit_erosion::jet::JetSlice;
+use grit_erosion::ImpactRecord;
+use serde::Deserialize;
+use uuid::Uuid;
 
 use super::AppState;
 use crate::api::*;
-use crate::checkpoint::{verify_upload, CheckpointBytes};
+use crate::checkpoint::{verify_any_upload, CheckpointBytes};
+use crate::db::Reported;
 use crate::error::{Error, Result};
+
+/// A heartbeat, complete, fail or release body of either scene: `HeartbeatRequest` and
+/// `JetHeartbeatRequest` (and their kin) in one, each field optional as in both.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Report {
+    lease_id: Uuid,
+    #[serde(default)]
+    impacts: Vec<ImpactRecord>,
+    #[serde(default)]
+    slices: Vec<JetSlice>,
+    #[serde(default)]
+    checkpoint: Option<Checkpoint>,
+    /// Only in a fail body.
+    #[serde(default)]
+    error: Option<String>,
+}
+
+impl Report {
+    fn reported(&self) -> Reported<'_> {
+        Reported {
+            impacts: &self.impacts,
+            slices: &self.slices,
+        }
+    }
+
+    /// The 422 for a field the endpoint does not take.
+    fn refuse(field: &str, endpoint: &str) -> Error {
+        Error::invalid(field, format!("unknown field for {endpoint}"))
+    }
+}
 
 /// The worker routes, relative to `/api/v1`.
 pub fn router() -> Router<AppState> {
@@ -27,7 +65,15 @@ pub fn router() -> Router<AppState> {
 
 /// The worker endpoints' part of the OpenAPI document.
 #[derive(utoipa::OpenApi)]
-#[openapi(paths(claim, heartbeat, complete, fail, release))]
+#[openapi(
+    paths(claim, heartbeat, complete, fail, release),
+    components(schemas(
+        JetHeartbeatRequest,
+        JetCompleteRequest,
+        JetFailRequest,
+        JetReleaseRequest
+    ))
+)]
 pub struct Doc;
 
 /// What a 422 to a request with a checkpoint may mean, for the OpenAPI document.
@@ -68,13 +114,12 @@ async fn check_checkpoint(
     let Some(c) = checkpoint else {
         return Ok(None);
     };
-    let (params, seed) = s.store.job_scene(job_id).await?;
-    // Decoding a checkpoint of a large surface takes milliseconds: off the async threads.
-    let checked = tokio::task::spawn_blocking(move || {
-        verify_upload(&c, job_id, &params, seed).map(|(_, bytes)| bytes)
-    })
-    .await
-    .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
+    let (params, seed) = s.store.job_params(job_id).await?;
+    // Decoding a checkpoint of a large surface or a jet's world takes milliseconds: off the
+    // async threads.
+    let checked = tokio::task::spawn_blocking(move || verify_any_upload(&c, job_id, &params, seed))
+        .await
+        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
     checked.map(Some).map_err(|e| {
         tracing::warn!(job = job_id, error = %e, "checkpoint refused; nothing of the request stored");
         Error::invalid(e.field, e.rule)
@@ -96,7 +141,7 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/heartbeat", params(("job_id" = i64, Path)),
-    request_body = HeartbeatRequest,
+    request_body(content = HeartbeatRequest, description = "a jet job sends JetHeartbeatRequest (`slices` for `impacts`)"),
     responses((status = 200, body = HeartbeatResponse), (status = 401), (status = 404, body = ErrorBody),
         (status = 409, body = ErrorBody, description = "not the lease holder; nothing stored"),
         (status = 410, body = ErrorBody, description = "campaign cancelled; drop the job"),
@@ -105,61 +150,76 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
 async fn heartbeat(
     State(s): State<AppState>,
     Path(job): Path<i64>,
-    ApiJson(req): ApiJson<HeartbeatRequest>,
+    ApiJson(mut req): ApiJson<Report>,
 ) -> Result<Json<HeartbeatResponse>> {
-    let checkpoint = check_checkpoint(&s, job, req.checkpoint).await?;
+    if req.error.is_some() {
+        return Err(Report::refuse("error", "heartbeat"));
+    }
+    let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
     Ok(Json(
         s.store
-            .heartbeat(job, req.lease_id, &req.impacts, checkpoint)
+            .heartbeat_with(job, req.lease_id, req.reported(), checkpoint)
             .await?,
     ))
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/complete", params(("job_id" = i64, Path)),
-    request_body = CompleteRequest,
+    request_body(content = CompleteRequest, description = "a jet job sends JetCompleteRequest (`slices` for `impacts`)"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody),
         (status = 410, body = ErrorBody), (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
 async fn complete(
     State(s): State<AppState>,
     Path(job): Path<i64>,
-    ApiJson(req): ApiJson<CompleteRequest>,
+    ApiJson(mut req): ApiJson<Report>,
 ) -> Result<StatusCode> {
-    let checkpoint = check_checkpoint(&s, job, req.checkpoint).await?;
+    if req.error.is_some() {
+        return Err(Report::refuse("error", "complete"));
+    }
+    let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
     s.store
-        .complete(job, req.lease_id, &req.impacts, checkpoint)
+        .complete_with(job, req.lease_id, req.reported(), checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/fail", params(("job_id" = i64, Path)),
-    request_body = FailRequest,
+    request_body(content = FailRequest, description = "a jet job sends JetFailRequest (`slices` for `impacts`)"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody)),
     security(("worker_token" = [])))]
 async fn fail(
     State(s): State<AppState>,
     Path(job): Path<i64>,
-    ApiJson(req): ApiJson<FailRequest>,
+    ApiJson(req): ApiJson<Report>,
 ) -> Result<StatusCode> {
+    if req.checkpoint.is_some() {
+        return Err(Report::refuse("checkpoint", "fail"));
+    }
+    let Some(error) = req.error.as_deref() else {
+        return Err(Error::invalid("error", "missing: say what went wrong"));
+    };
     s.store
-        .fail(job, req.lease_id, &req.error, &req.impacts)
+        .fail_with(job, req.lease_id, error, req.reported())
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/release", params(("job_id" = i64, Path)),
-    request_body = ReleaseRequest,
+    request_body(content = ReleaseRequest, description = "a jet job sends JetReleaseRequest (`slices` for `impacts`)"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody),
         (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
 async fn release(
     State(s): State<AppState>,
     Path(job): Path<i64>,
-    ApiJson(req): ApiJson<ReleaseRequest>,
+    ApiJson(mut req): ApiJson<Report>,
 ) -> Result<StatusCode> {
-    let checkpoint = check_checkpoint(&s, job, req.checkpoint).await?;
+    if req.error.is_some() {
+        return Err(Report::refuse("error", "release"));
+    }
+    let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
     s.store
-        .release(job, req.lease_id, &req.impacts, checkpoint)
+        .release_with(job, req.lease_id, req.reported(), checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
