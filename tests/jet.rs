@@ -87,3 +87,63 @@ fn bad_jet_input_names_the_field_and_exits_non_zero() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn grit_plot_gathers_jet_run_files_into_a_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.json");
+    std::fs::write(&scene, TINY).unwrap();
+    let mut files = Vec::new();
+    for seed in ["1", "2"] {
+        let file = dir.path().join(format!("run-{seed}.json"));
+        let out = grit(&[
+            "jet",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--time-ms",
+            "0.002",
+            "--seed",
+            seed,
+            "-o",
+            file.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        files.push(file.to_str().unwrap().to_string());
+    }
+    let charts = dir.path().join("charts");
+    let mut args = vec!["plot", "--out", charts.to_str().unwrap()];
+    args.extend(files.iter().map(String::as_str));
+    let out = grit(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // One cell (equal parameters) of two samples, the seeds.
+    let row = stdout.lines().nth(1).unwrap_or_default();
+    assert!(row.contains("500 m/s") && row.contains(" 2 "), "{stdout}");
+    for chart in [
+        "jet_depth_vs_time",
+        "jet_mass_loss_vs_time",
+        "jet_depth_vs_speed",
+    ] {
+        png_ok(&charts.join(format!("{chart}.png")));
+    }
+    // The same seed twice is refused, naming the run.
+    let out = grit(&["plot", &files[0], &files[0]]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("runs[1].seed"), "{err}");
+    // A run file beside another kind of file is refused, naming the other.
+    let other = dir.path().join("scene-copy.json");
+    std::fs::write(&other, TINY).unwrap();
+    let out = grit(&["plot", &files[0], other.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("scene-copy.json"), "{err}");
+}

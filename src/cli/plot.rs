@@ -16,7 +16,8 @@ use plotters::prelude::*;
 pub struct Args {
     /// Results JSON from `grit run` (OUT/results.json) or `grit results -o FILE`; per-sample
     /// curves need the raw series (`--raw` on either). Several files are drawn as one; a cell
-    /// (angle, shape) an earlier file already has is left out.
+    /// (angle, shape) an earlier file already has is left out. Files from `grit jet -o` are
+    /// gathered into cells (equal parameters; seeds are samples) and drawn as a jet campaign.
     #[arg(required = true)]
     pub results: Vec<PathBuf>,
     /// Folder for the PNG and SVG charts (default: the first results file's folder).
@@ -109,14 +110,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         });
+    // Single `grit jet` runs are gathered into cells and drawn as a jet campaign.
+    if let Some(r) = grit_plot::load_jet_runs(&a.results)? {
+        return draw_jet(&r, &out);
+    }
     // A jet campaign's results have their own charts, drawn one file at a time.
     if let [one] = a.results.as_slice() {
         if let grit_plot::AnyInput::Jet(r) = grit_plot::load_any(one)? {
-            let report = grit_plot::plot_jet(&r, &out)?;
-            let mut o = std::io::stdout().lock();
-            let _ = write!(o, "{}", grit_plot::jet_summary_table(&r));
-            print_report(&mut o, &[], &report);
-            return Ok(ExitCode::SUCCESS);
+            return draw_jet(&r, &out);
         }
     }
     let inputs = a
@@ -129,6 +130,18 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut o = std::io::stdout().lock();
     let _ = write!(o, "{}", grit_plot::summary_table(&input.results));
     print_report(&mut o, &merge_notes, &report);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Draws a jet campaign's charts and prints its table and the files written.
+fn draw_jet(
+    r: &grit_erosion::jet::aggregate::JetCampaignResults,
+    out: &Path,
+) -> anyhow::Result<ExitCode> {
+    let report = grit_plot::plot_jet(r, out)?;
+    let mut o = std::io::stdout().lock();
+    let _ = write!(o, "{}", grit_plot::jet_summary_table(r));
+    print_report(&mut o, &[], &report);
     Ok(ExitCode::SUCCESS)
 }
 

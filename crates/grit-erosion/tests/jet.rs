@@ -109,3 +109,32 @@ fn bad_parameters_are_named() {
     let named: JetParams = serde_json::from_str(r#"{"material": "al6061"}"#).unwrap();
     assert_eq!(named.material.0.name, "al6061");
 }
+
+#[test]
+fn a_run_extends_to_its_own_end_or_later_but_not_into_its_slices() {
+    let mut p = tiny();
+    p.time_ms = 0.002;
+    let mut run = JetRun::new(p, 5).unwrap();
+    while !run.finished() {
+        run.run_next_slice().unwrap();
+    }
+    // The clock stops on the step past 2 µs; asking for exactly 2 µs again is no error.
+    assert!(run.slices()[1].sample.t_s >= 2e-6);
+    run.extend(0.002).unwrap();
+    assert!(run.finished());
+    let e = run.extend(0.0015).unwrap_err().to_string();
+    assert!(e.contains("time_ms") && e.contains("cannot end"), "{e}");
+    run.extend(0.003).unwrap();
+    assert!(!run.finished());
+    run.run_next_slice().unwrap();
+    assert!(run.finished());
+    // A run whose last slice was short cannot be made longer.
+    let mut p = tiny();
+    p.time_ms = 0.0015;
+    let mut short = JetRun::new(p, 5).unwrap();
+    while !short.finished() {
+        short.run_next_slice().unwrap();
+    }
+    let e = short.extend(0.003).unwrap_err().to_string();
+    assert!(e.contains("ended short"), "{e}");
+}

@@ -31,7 +31,8 @@ use grit_erosion::CampaignResults;
 pub use draw::colour;
 pub use fonts::register_fonts;
 pub use input::{
-    load, load_any, merge, parse, parse_any, AnyInput, PlotInput, RawImpact, RawSeries,
+    load, load_any, load_jet_runs, merge, parse, parse_any, AnyInput, PlotInput, RawImpact,
+    RawSeries,
 };
 pub use jet::{jet_summary_table, plot_jet};
 pub use jet_picture::{jet_png, JetField, JetPicture};

@@ -8,6 +8,7 @@
 
 pub mod aggregate;
 mod feed;
+pub mod runs;
 mod scene;
 
 use grit_sph::crater::{self, CraterOptions, CraterSample};
@@ -330,14 +331,27 @@ impl JetRun {
     /// Runs on to `time_ms` in all (a resumed run made longer); its slices so far stay, so
     /// `time_ms` must not cut into them.
     pub fn extend(&mut self, time_ms: f64) -> Result<(), JetError> {
-        let done_ms = self.slices.last().map_or(0.0, |s| s.sample.t_s * 1e3);
+        // Slices end on the step past their planned time, so the reached time may exceed the
+        // planned one by a step: the plan, not the clock, says what has been run.
+        let done = self.slices_done();
+        let done_ms = (f64::from(done) * self.params.slice_ms).min(self.params.time_ms);
         let mut p = self.params.clone();
         p.time_ms = time_ms;
         p.validate()?;
-        if time_ms < done_ms - 1e-9 || p.slices() < self.slices_done() {
+        if time_ms < done_ms * (1.0 - 1e-9) || p.slices() < done {
             return Err(JetError::Input(InputError::new(
                 "time_ms",
                 format!("the run has reached {done_ms} ms; it cannot end at {time_ms} ms"),
+            )));
+        }
+        let short_last = f64::from(done) * self.params.slice_ms > done_ms * (1.0 + 1e-9);
+        if short_last && time_ms > done_ms * (1.0 + 1e-9) {
+            return Err(JetError::Input(InputError::new(
+                "time_ms",
+                format!(
+                    "the run's last slice ended short, at {done_ms} ms; only a run of whole slices of {} ms can be made longer",
+                    self.params.slice_ms
+                ),
             )));
         }
         self.params = p;
