@@ -4,8 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use grit_erosion::campaign::CampaignSpec;
+use grit_erosion::campaign::{CampaignSpec, JetCampaignSpec};
 
+/// Impact specs name their angles, jet specs their scene; results files have cells.
 fn specs_in(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -13,8 +14,8 @@ fn specs_in(dir: &Path, out: &mut Vec<PathBuf>) {
             specs_in(&path, out);
         } else if path.extension().is_some_and(|e| e == "json") {
             let text = std::fs::read_to_string(&path).unwrap();
-            // Results files and sweep outputs are JSON too; a spec names its angles.
-            if text.contains("\"angles_deg\"") && !text.contains("\"cells\"") {
+            let spec = text.contains("\"angles_deg\"") || text.contains("\"scene\": \"jet\"");
+            if spec && !text.contains("\"cells\"") {
                 out.push(path);
             }
         }
@@ -28,14 +29,17 @@ fn every_shipped_campaign_spec_parses_validates_and_expands() {
     specs_in(&root.join("examples"), &mut specs);
     let in_examples = specs.len();
     specs_in(&root.join("docs"), &mut specs);
-    assert!(in_examples >= 10, "examples/ has {in_examples} specs");
+    assert!(in_examples >= 12, "examples/ has {in_examples} specs");
     for path in &specs {
         let text = std::fs::read_to_string(path).unwrap();
-        let spec =
-            CampaignSpec::from_json(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let jobs = spec
-            .expand()
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert!(!jobs.is_empty(), "{}: no jobs", path.display());
+        let fail = |e: &dyn std::fmt::Display| -> ! { panic!("{}: {e}", path.display()) };
+        let jobs = if text.contains("\"scene\": \"jet\"") {
+            let spec = JetCampaignSpec::from_json(&text).unwrap_or_else(|e| fail(&e));
+            spec.expand().unwrap_or_else(|e| fail(&e)).len()
+        } else {
+            let spec = CampaignSpec::from_json(&text).unwrap_or_else(|e| fail(&e));
+            spec.expand().unwrap_or_else(|e| fail(&e)).len()
+        };
+        assert!(jobs > 0, "{}: no jobs", path.display());
     }
 }

@@ -38,6 +38,6 @@ pub use particles::Particles;
 pub use timers::{Stage, Timers};
 pub use world::{
     Abrasives, CeilingPass, DensityFilter, Energy, GrainOutflow, Inflow, Nozzle, NumericalWork,
-    Outflow, PenaltyParams, Settings, World,
+    Outflow, PenaltyParams, Settings, WallLoad, World,
 };
 pub mod verification;

@@ -215,21 +215,41 @@ pub(crate) fn fluid_accelerations(
         });
 }
 
+/// The load of a fluid on one of its wall particles in a step (the AWJ paper eqs. 23, 25–27).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WallLoad {
+    /// The body of the wall particle.
+    pub body: u32,
+    /// Its position (m).
+    pub position: Vector,
+    /// The force of the fluid's pair terms on it, m a (N/m).
+    pub force: Vector,
+}
+
 /// Per body, Σ m a over its kinematic fluid particles, from the pair accelerations of
 /// [`fluid_accelerations`]: the force its fluid puts on its walls (N/m; zero for bodies without
-/// walls). Summed serially in particle order, so the bits do not depend on the thread count.
+/// walls), and each wall particle's share in `loads`. Summed serially in particle order, so
+/// the bits do not depend on the thread count.
 pub(crate) fn wall_forces(
     p: &Particles,
     bc: &[BodyConst],
     accel: &[Vector],
     out: &mut Vec<Vector>,
+    loads: &mut Vec<WallLoad>,
 ) {
     out.clear();
     out.resize(bc.len(), Vector::zeros());
+    loads.clear();
     for (i, a) in accel.iter().enumerate().take(p.len()) {
         let b = p.body[i] as usize;
         if bc[b].fluid.is_some() && p.flags[i] & KINEMATIC != 0 {
-            out[b] += a * p.mass[i];
+            let force = a * p.mass[i];
+            out[b] += force;
+            loads.push(WallLoad {
+                body: b as u32,
+                position: p.pos[i],
+                force,
+            });
         }
     }
 }

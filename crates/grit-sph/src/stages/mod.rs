@@ -24,6 +24,7 @@ pub use ceiling::CeilingPass;
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
 use fluid::fluid_dt;
+pub use fluid::WallLoad;
 pub(crate) use fluid::{
     fluid_accelerations, fluid_continuity, fluid_density, particle_state, wall_forces, FluidConst,
 };

@@ -43,6 +43,9 @@ pub struct JetWallRun {
     pub max_particles: usize,
     /// Mass released, deleted, and held by the free fluid at the end, less at the start (kg/m).
     pub mass_in_out_held: [f64; 3],
+    /// The wall pressure over the window per wall column: (column centre x (m), the mean
+    /// wall-normal force of the column's particles over the column's width (Pa)), left to right.
+    pub pressure_profile: Vec<(f64, f64)>,
 }
 
 /// A world with the jet's wall and outflow box, `n` particles across the jet of width
@@ -115,6 +118,9 @@ pub fn run_jet_wall(n: usize, speed: f64, water: Fluid) -> Result<JetWallRun, Si
     let (mut impulse, mut span, mut peak) = (0.0, 0.0, 0.0_f64);
     let mut trace = (Vec::new(), Vec::new());
     let mut max_particles = 0;
+    let dx = JET_B / n as f64;
+    // Wall-normal impulse per wall column, by column index (x = (i + 1/2) dx).
+    let mut column_impulse = std::collections::BTreeMap::<i64, f64>::new();
     while world.time() < t1 {
         let dt = world.next_dt();
         world.step()?;
@@ -124,6 +130,10 @@ pub fn run_jet_wall(n: usize, speed: f64, water: Fluid) -> Result<JetWallRun, Si
         if t > t0 {
             impulse += f * dt;
             span += dt;
+            for load in world.wall_loads() {
+                let column = (load.position.x / dx).floor() as i64;
+                *column_impulse.entry(column).or_default() -= load.force.y * dt;
+            }
         } else if t < t_hit + HAMMER_B_OVER_V * t_b {
             peak = peak.max(f);
         }
@@ -142,6 +152,10 @@ pub fn run_jet_wall(n: usize, speed: f64, water: Fluid) -> Result<JetWallRun, Si
         steps: world.steps(),
         max_particles,
         mass_in_out_held: [mass_in, mass_out, held(&world) - held0],
+        pressure_profile: column_impulse
+            .into_iter()
+            .map(|(i, j)| ((i as f64 + 0.5) * dx, j / (span * dx)))
+            .collect(),
     })
 }
 
@@ -197,6 +211,48 @@ pub fn jet_wall(n: usize, speed: f64) -> Result<CaseReport, SimError> {
              (S1 = {s1}); reference is the nearer end, or the value itself inside"
         ),
     });
+    // The two columns either side of the centre line, x = ±Δx/2.
+    let centre: Vec<f64> = r
+        .pressure_profile
+        .iter()
+        .filter(|(x, _)| x.abs() < 0.75 * JET_B / n as f64)
+        .map(|&(_, p)| p)
+        .collect();
+    let stagnation = 0.5 * rho0 * speed * speed;
+    let p0 = centre.iter().sum::<f64>() / centre.len().max(1) as f64;
+    let err = (p0 - stagnation).abs() / stagnation;
+    rep.rows.push(Row {
+        case: "jet_wall_stagnation".into(),
+        resolution: format!("b/dx = {n}, v = {speed} m/s"),
+        value: p0,
+        reference: stagnation,
+        error_rel: err,
+        pass: err <= TOL_JET_WALL,
+        expected_fail: false,
+        note: format!(
+            "wall pressure (Pa) on the centre line: the wall-normal force of the two wall \
+             columns at x = +-dx/2 over their width, averaged over {}-{} b/v, against the \
+             stagnation pressure rho0 v^2 / 2; bound 5%",
+            WINDOW_B_OVER_V.0, WINDOW_B_OVER_V.1
+        ),
+    });
+    let (xs, ps): (Vec<f64>, Vec<f64>) = r
+        .pressure_profile
+        .iter()
+        .map(|&(x, p)| (x / JET_B, p / stagnation))
+        .unzip();
+    rep.charts.push(Chart {
+        name: "jet_wall_pressure".into(),
+        title: format!("Wall pressure under the jet, v = {speed} m/s, {n} particles across"),
+        x_label: "x / b".into(),
+        y_label: "wall pressure / (rho0 v^2 / 2)".into(),
+        series: vec![Series {
+            label: "SPH, wall columns".into(),
+            x: xs,
+            y: ps,
+            reference: false,
+        }],
+    });
     let (t, f) = r.trace;
     let flat = vec![reference; t.len()];
     rep.charts.push(Chart {
@@ -236,5 +292,9 @@ mod tests {
         let flux = 1000.0 * 400.0 * 400.0 * JET_B;
         assert!((r.force_n_m / flux - 1.0).abs() < 0.1, "{:e}", r.force_n_m);
         assert!(r.peak_n_m > r.force_n_m);
+        // The wall columns' pressures integrate to the wall's force.
+        let dx = JET_B / 8.0;
+        let sum: f64 = r.pressure_profile.iter().map(|(_, p)| p * dx).sum();
+        assert!((sum / r.force_n_m - 1.0).abs() < 1e-9, "{sum:e}");
     }
 }

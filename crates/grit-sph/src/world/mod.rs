@@ -11,7 +11,7 @@ mod diagnostics;
 mod flow;
 mod settings;
 
-pub use crate::stages::{CeilingPass, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
+pub use crate::stages::{CeilingPass, WallLoad, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 pub use abrasives::{plane_mass, Abrasives, GrainOutflow, PenaltyParams};
 pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
@@ -51,6 +51,8 @@ struct Scratch {
     drho: Vec<f64>,
     /// Per body, the force the fluid's pair terms put on its kinematic particles.
     wall_force: Vec<Vector>,
+    /// The same force per wall particle.
+    wall_loads: Vec<WallLoad>,
     /// Porosity ε of every particle (eq. 20; 1 away from grains), for the coupling's averages
     /// and drag (the fluid's EOS reads ρ̄ alone: docs/jet.md#porosity-and-the-eos).
     porosity: Vec<f64>,
@@ -197,6 +199,12 @@ impl World {
             .get(b)
             .copied()
             .unwrap_or_else(Vector::zeros)
+    }
+    /// The fluids' loads on each of their wall particles in the last step (N/m), in particle
+    /// order: the pressure distribution along a wall ([`World::wall_force`] is their sum per
+    /// body).
+    pub fn wall_loads(&self) -> &[WallLoad] {
+        &self.scratch.wall_loads
     }
     /// Neighbour count of each particle as last built (for reports).
     pub fn neighbour_pairs(&self) -> usize {
@@ -526,7 +534,7 @@ impl World {
                 let cross = &self.nbrs.cross;
                 stages::interface_forces(s, cross, state, av, &mut sc.acc, &mut sc.theta);
             }
-            stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_force);
+            stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_force, &mut sc.wall_loads);
         }
     }
 
