@@ -87,9 +87,41 @@ pub fn cell_label(c: &JetCellResult) -> String {
         None => format!("{} m/s", c.velocity_m_s),
     };
     for (k, v) in c.swept.iter().filter(|(k, _)| !is_speed(k)) {
-        s.push_str(&format!(", {k} {v}"));
+        s.push_str(&format!(", {}", swept_text(c, k, *v)));
     }
     s
+}
+
+/// A swept value in words: a swept material by its name, not its index in the spec.
+fn swept_text(c: &JetCellResult, name: &str, value: f64) -> String {
+    if name == "material_index" {
+        c.material.clone()
+    } else {
+        format!("{name} {}", four_digits(value))
+    }
+}
+
+/// `v` to four significant digits without trailing zeros (`8.333e-5`, `0.02`, `500`).
+fn four_digits(v: f64) -> String {
+    let trim = |s: String| -> String {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    let a = v.abs();
+    if a == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    if (1e-3..1e6).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        trim(format!("{v:.decimals$}"))
+    } else {
+        let s = format!("{v:.3e}");
+        let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        format!("{}e{exp}", trim(mantissa.to_string()))
+    }
 }
 
 fn is_speed(name: &str) -> bool {
@@ -111,7 +143,7 @@ fn group_label(c: &JetCellResult) -> String {
         .swept
         .iter()
         .filter(|(k, _)| !is_speed(k))
-        .map(|(k, v)| format!("{k} {v}"))
+        .map(|(k, v)| swept_text(c, k, *v))
         .collect();
     if parts.is_empty() {
         format!(
@@ -544,4 +576,18 @@ pub fn jet_summary_table(results: &JetCampaignResults) -> String {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn swept_values_are_shown_to_four_digits() {
+        assert_eq!(four_digits(1e-4 / 1.2), "8.333e-5");
+        assert_eq!(four_digits(0.02), "0.02");
+        assert_eq!(four_digits(500.0), "500");
+        assert_eq!(four_digits(6.25e-5), "6.25e-5");
+        assert_eq!(four_digits(1.0 / 3.0), "0.3333");
+    }
 }
