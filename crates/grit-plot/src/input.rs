@@ -198,6 +198,51 @@ pub fn merge(inputs: Vec<(String, PlotInput)>) -> Result<(PlotInput, Vec<String>
     Ok((merged, notes))
 }
 
+/// Whether parsed JSON is one `grit jet` run (`params`, `seed`, `slices`; no `scene`).
+fn is_jet_run(value: &Value) -> bool {
+    value.get("scene").is_none()
+        && ["params", "seed", "slices"]
+            .iter()
+            .all(|k| value.get(k).is_some())
+}
+
+/// Reads `grit jet -o` run files as one jet campaign ([`grit_erosion::jet::runs`]): `None`
+/// when none of them is a run file; an error naming the file when only some are, or when one
+/// cannot be read.
+pub fn load_jet_runs(
+    paths: &[std::path::PathBuf],
+) -> Result<Option<JetCampaignResults>, PlotError> {
+    let mut runs = Vec::new();
+    let mut others = Vec::new();
+    for path in paths {
+        let text = std::fs::read_to_string(path).map_err(|error| PlotError::Read {
+            path: path.clone(),
+            error,
+        })?;
+        let at = |e: String| PlotError::Input(format!("{}: {e}", path.display()));
+        let value: Value =
+            serde_json::from_str(&text).map_err(|e| at(format!("not valid JSON: {e}")))?;
+        if !is_jet_run(&value) {
+            others.push(path.display().to_string());
+            continue;
+        }
+        let run: JetRunRecord = serde_path_to_error::deserialize(value)
+            .map_err(|e| at(format!("{}: {}", e.path(), e.inner())))?;
+        runs.push(run);
+    }
+    if runs.is_empty() {
+        return Ok(None);
+    }
+    if let Some(other) = others.first() {
+        return Err(PlotError::Input(format!(
+            "{other}: not a `grit jet` run file, but the other files are; plot run files together and campaign results on their own"
+        )));
+    }
+    let cells = cells_from_runs(&runs).map_err(|e| PlotError::Input(e.to_string()))?;
+    let results = aggregate_jet_campaign(&cells).map_err(|e| PlotError::Input(e.to_string()))?;
+    Ok(Some(results))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -270,49 +315,4 @@ mod tests {
         c.results.slope_window = 10;
         assert!(merge(vec![("a".into(), other), ("c".into(), c)]).is_err());
     }
-}
-
-/// Whether parsed JSON is one `grit jet` run (`params`, `seed`, `slices`; no `scene`).
-fn is_jet_run(value: &Value) -> bool {
-    value.get("scene").is_none()
-        && ["params", "seed", "slices"]
-            .iter()
-            .all(|k| value.get(k).is_some())
-}
-
-/// Reads `grit jet -o` run files as one jet campaign ([`grit_erosion::jet::runs`]): `None`
-/// when none of them is a run file; an error naming the file when only some are, or when one
-/// cannot be read.
-pub fn load_jet_runs(
-    paths: &[std::path::PathBuf],
-) -> Result<Option<JetCampaignResults>, PlotError> {
-    let mut runs = Vec::new();
-    let mut others = Vec::new();
-    for path in paths {
-        let text = std::fs::read_to_string(path).map_err(|error| PlotError::Read {
-            path: path.clone(),
-            error,
-        })?;
-        let at = |e: String| PlotError::Input(format!("{}: {e}", path.display()));
-        let value: Value =
-            serde_json::from_str(&text).map_err(|e| at(format!("not valid JSON: {e}")))?;
-        if !is_jet_run(&value) {
-            others.push(path.display().to_string());
-            continue;
-        }
-        let run: JetRunRecord = serde_path_to_error::deserialize(value)
-            .map_err(|e| at(format!("{}: {}", e.path(), e.inner())))?;
-        runs.push(run);
-    }
-    if runs.is_empty() {
-        return Ok(None);
-    }
-    if let Some(other) = others.first() {
-        return Err(PlotError::Input(format!(
-            "{other}: not a `grit jet` run file, but the other files are; plot run files together and campaign results on their own"
-        )));
-    }
-    let cells = cells_from_runs(&runs).map_err(|e| PlotError::Input(e.to_string()))?;
-    let results = aggregate_jet_campaign(&cells).map_err(|e| PlotError::Input(e.to_string()))?;
-    Ok(Some(results))
 }

@@ -12,7 +12,7 @@ pub mod material;
 pub use eos::{EquationOfState, MieGruneisen};
 pub use error::{InputError, SimError};
 pub use fluid::{Fluid, FLUID_NAMES};
-pub use material::{JohnsonCook, JohnsonCookDamage, Material, MATERIAL_NAMES};
+pub use material::{Fracture, JohnsonCook, JohnsonCookDamage, Material, Strength, MATERIAL_NAMES};
 pub mod body;
 pub mod contact;
 pub mod coupling;

@@ -3,7 +3,7 @@
 //! The water-jet scene's metals (OFHC copper, Al 6061-T6) add a Mie–Grüneisen EOS
 //! (docs/jet.md#metal-targets).
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::eos::{EquationOfState, MieGruneisen};
 use crate::error::InputError;
@@ -26,10 +26,10 @@ pub struct Material {
     pub poisson_ratio: f64,
     /// Specific heat capacity Cp (J/(kg·K)), for adiabatic heating from plastic work.
     pub heat_capacity_j_kgk: f64,
-    /// Johnson–Cook strength parameters (eq. 18); `None` keeps the material elastic.
-    pub plasticity: Option<JohnsonCook>,
-    /// Johnson–Cook fracture parameters (eqs. 19–20); `None` disables damage.
-    pub damage: Option<JohnsonCookDamage>,
+    /// Strength law (Johnson–Cook, eq. 18); `None` keeps the material elastic.
+    pub plasticity: Option<Strength>,
+    /// Fracture law (Johnson–Cook, eqs. 19–20); `None` disables damage.
+    pub damage: Option<Fracture>,
     /// Pressure law; `None` is the linear `p = K (ρ/ρ0 − 1)` of seed eq. 11 (and is left out of
     /// the JSON, so materials stored before this field existed keep their bytes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -62,6 +62,69 @@ pub struct JohnsonCook {
     pub t_melt_k: f64,
 }
 
+/// A strength law: how the deviatoric stress yields (seed eq. 18). An enum so that a brittle
+/// law (JH-2 for rock, docs/jet.md#open-points) can sit beside Johnson–Cook; in JSON it is
+/// the law's parameters alone, as before there was a choice.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Strength {
+    /// Johnson–Cook (seed eq. 18).
+    JohnsonCook(JohnsonCook),
+}
+
+impl Strength {
+    /// The Johnson–Cook parameters, when this is Johnson–Cook.
+    pub fn johnson_cook(&self) -> Option<&JohnsonCook> {
+        match self {
+            Strength::JohnsonCook(jc) => Some(jc),
+        }
+    }
+}
+
+impl Serialize for Strength {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Strength::JohnsonCook(jc) => jc.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Strength {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        JohnsonCook::deserialize(d).map(Strength::JohnsonCook)
+    }
+}
+
+/// A fracture law: the strain at which damage reaches 1 (seed eqs. 19–20); an enum for the
+/// same reason as [`Strength`], written in JSON as the law's parameters alone.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Fracture {
+    /// Johnson–Cook (seed eqs. 19–20).
+    JohnsonCook(JohnsonCookDamage),
+}
+
+impl Fracture {
+    /// The Johnson–Cook parameters, when this is Johnson–Cook.
+    pub fn johnson_cook(&self) -> Option<&JohnsonCookDamage> {
+        match self {
+            Fracture::JohnsonCook(d) => Some(d),
+        }
+    }
+}
+
+impl Serialize for Fracture {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Fracture::JohnsonCook(d) => d.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Fracture {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        JohnsonCookDamage::deserialize(d).map(Fracture::JohnsonCook)
+    }
+}
+
 /// Johnson–Cook fracture strain parameters (seed eq. 20).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -89,7 +152,7 @@ impl Material {
             youngs_modulus_pa: 200e9,
             poisson_ratio: 0.3,
             heat_capacity_j_kgk: 510.0,
-            plasticity: Some(JohnsonCook {
+            plasticity: Some(Strength::JohnsonCook(JohnsonCook {
                 a_pa: 555.5e6,
                 b_pa: 1379e6,
                 n: 0.9497,
@@ -98,15 +161,15 @@ impl Material {
                 m: 1.3263,
                 t_ref_k: 293.0,
                 t_melt_k: 1673.0,
-            }),
-            damage: Some(JohnsonCookDamage {
+            })),
+            damage: Some(Fracture::JohnsonCook(JohnsonCookDamage {
                 d1: -0.7786,
                 d2: 2.5588,
                 d3: -0.3607,
                 d4: -0.0191,
                 d5: 0.0,
                 ref_strain_rate_s: 1e-3,
-            }),
+            })),
             eos: None,
         }
     }
@@ -120,7 +183,7 @@ impl Material {
             youngs_modulus_pa: 124e9,
             poisson_ratio: 0.34,
             heat_capacity_j_kgk: 383.0,
-            plasticity: Some(JohnsonCook {
+            plasticity: Some(Strength::JohnsonCook(JohnsonCook {
                 a_pa: 90e6,
                 b_pa: 292e6,
                 n: 0.31,
@@ -129,15 +192,15 @@ impl Material {
                 m: 1.09,
                 t_ref_k: 293.0,
                 t_melt_k: 1356.0,
-            }),
-            damage: Some(JohnsonCookDamage {
+            })),
+            damage: Some(Fracture::JohnsonCook(JohnsonCookDamage {
                 d1: 0.54,
                 d2: 4.89,
                 d3: -3.03,
                 d4: 0.014,
                 d5: 1.12,
                 ref_strain_rate_s: 1.0,
-            }),
+            })),
             eos: Some(EquationOfState::MieGruneisen(MieGruneisen {
                 rho0_kg_m3: 8960.0,
                 c0_m_s: 3940.0,
@@ -159,7 +222,7 @@ impl Material {
             youngs_modulus_pa: 68.9e9,
             poisson_ratio: 0.33,
             heat_capacity_j_kgk: 896.0,
-            plasticity: Some(JohnsonCook {
+            plasticity: Some(Strength::JohnsonCook(JohnsonCook {
                 a_pa: 324e6,
                 b_pa: 114e6,
                 n: 0.42,
@@ -168,15 +231,15 @@ impl Material {
                 m: 1.34,
                 t_ref_k: 293.0,
                 t_melt_k: 933.0,
-            }),
-            damage: Some(JohnsonCookDamage {
+            })),
+            damage: Some(Fracture::JohnsonCook(JohnsonCookDamage {
                 d1: -0.77,
                 d2: 1.45,
                 d3: -0.47,
                 d4: 0.0,
                 d5: 1.6,
                 ref_strain_rate_s: 1.0,
-            }),
+            })),
             eos: Some(EquationOfState::MieGruneisen(MieGruneisen {
                 rho0_kg_m3: 2703.0,
                 c0_m_s: 5350.0,
@@ -270,7 +333,7 @@ impl Material {
                 format!("must lie in (-1, 0.5), got {}", self.poisson_ratio),
             ));
         }
-        if let Some(jc) = &self.plasticity {
+        if let Some(Strength::JohnsonCook(jc)) = &self.plasticity {
             pos("plasticity.a_pa", jc.a_pa)?;
             if !(jc.b_pa.is_finite() && jc.b_pa >= 0.0) {
                 return Err(InputError::new(
@@ -296,7 +359,7 @@ impl Material {
                 ));
             }
         }
-        if let Some(d) = &self.damage {
+        if let Some(Fracture::JohnsonCook(d)) = &self.damage {
             if self.plasticity.is_none() {
                 return Err(InputError::new(
                     "material.damage",
@@ -345,13 +408,17 @@ mod tests {
             m.validate().unwrap();
         }
         let cu = Material::copper();
-        let jc = cu.plasticity.as_ref().unwrap();
+        let jc = cu
+            .plasticity
+            .as_ref()
+            .and_then(Strength::johnson_cook)
+            .unwrap();
         assert_eq!(
             (jc.a_pa, jc.b_pa, jc.n, jc.c, jc.m),
             (90e6, 292e6, 0.31, 0.025, 1.09)
         );
         assert_eq!((jc.ref_strain_rate_s, jc.t_melt_k), (1.0, 1356.0));
-        let d = cu.damage.as_ref().unwrap();
+        let d = cu.damage.as_ref().and_then(Fracture::johnson_cook).unwrap();
         assert_eq!(
             (d.d1, d.d2, d.d3, d.d4, d.d5),
             (0.54, 4.89, -3.03, 0.014, 1.12)
@@ -365,13 +432,17 @@ mod tests {
         );
 
         let al = Material::al6061();
-        let jc = al.plasticity.as_ref().unwrap();
+        let jc = al
+            .plasticity
+            .as_ref()
+            .and_then(Strength::johnson_cook)
+            .unwrap();
         assert_eq!(
             (jc.a_pa, jc.b_pa, jc.n, jc.c, jc.m),
             (324e6, 114e6, 0.42, 0.002, 1.34)
         );
         assert_eq!(jc.t_melt_k, 933.0);
-        let d = al.damage.as_ref().unwrap();
+        let d = al.damage.as_ref().and_then(Fracture::johnson_cook).unwrap();
         assert_eq!(
             (d.d1, d.d2, d.d3, d.d4, d.d5),
             (-0.77, 1.45, -0.47, 0.0, 1.6)

@@ -134,12 +134,17 @@ pub fn fracture_strain(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::Material;
+    use crate::material::{Fracture, Material, Strength};
 
     #[test]
     fn radial_return_lands_on_the_yield_surface() {
         let m = Material::aisi304();
-        let jc = m.plasticity.clone().unwrap();
+        let jc = m
+            .plasticity
+            .as_ref()
+            .and_then(Strength::johnson_cook)
+            .unwrap()
+            .clone();
         let g = m.shear_modulus();
         let s = Matrix::new(3e9, 1e9, 1e9, -1e9);
         let dt = 1e-9;
@@ -158,7 +163,12 @@ mod tests {
     #[test]
     fn elastic_state_is_untouched() {
         let m = Material::aisi304();
-        let jc = m.plasticity.clone().unwrap();
+        let jc = m
+            .plasticity
+            .as_ref()
+            .and_then(Strength::johnson_cook)
+            .unwrap()
+            .clone();
         let s = Matrix::new(1e8, 0.0, 0.0, -1e8);
         let r = radial_return(s, m.shear_modulus(), &jc, 0.0, 1e-9, 293.0);
         assert_eq!(r.d_eps, 0.0);
@@ -167,18 +177,28 @@ mod tests {
 
     #[test]
     fn yield_is_zero_at_melt_and_rate_term_never_softens() {
-        let jc = Material::aisi304().plasticity.unwrap();
-        assert_eq!(jc_yield(&jc, 0.2, 1e3, jc.t_melt_k + 10.0).0, 0.0);
-        let slow = jc_yield(&jc, 0.0, 1e-8, 293.0).0;
+        let m = Material::aisi304();
+        let jc = m
+            .plasticity
+            .as_ref()
+            .and_then(Strength::johnson_cook)
+            .unwrap();
+        assert_eq!(jc_yield(jc, 0.2, 1e3, jc.t_melt_k + 10.0).0, 0.0);
+        let slow = jc_yield(jc, 0.0, 1e-8, 293.0).0;
         assert_eq!(slow, jc.a_pa);
     }
 
     #[test]
     fn fracture_strain_follows_triaxiality() {
         let m = Material::aisi304();
-        let (d, jc) = (m.damage.unwrap(), m.plasticity.unwrap());
-        let comp = fracture_strain(&d, &jc, -1.0, 1.0, 293.0);
-        let tens = fracture_strain(&d, &jc, 1.0, 1.0, 293.0);
+        let d = m.damage.as_ref().and_then(Fracture::johnson_cook).unwrap();
+        let jc = m
+            .plasticity
+            .as_ref()
+            .and_then(Strength::johnson_cook)
+            .unwrap();
+        let comp = fracture_strain(d, jc, -1.0, 1.0, 293.0);
+        let tens = fracture_strain(d, jc, 1.0, 1.0, 293.0);
         assert!(
             comp > tens,
             "compression must be more ductile: {comp} vs {tens}"

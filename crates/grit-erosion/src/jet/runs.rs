@@ -21,8 +21,11 @@ pub struct JetRunRecord {
     pub slices: Vec<JetSlice>,
 }
 
+/// Reads one numeric parameter of a run.
+type Field = fn(&JetParams) -> f64;
+
 /// The numeric parameters a set of runs may differ in, by spec name.
-const SWEEPABLE: [(&str, fn(&JetParams) -> f64); 5] = [
+const SWEEPABLE: [(&str, Field); 5] = [
     ("velocity_m_s", |p| p.velocity_m_s),
     ("mass_flow_kg_s", |p| p.mass_flow_kg_s),
     ("time_ms", |p| p.time_ms),
@@ -59,7 +62,7 @@ pub fn cells_from_runs(runs: &[JetRunRecord]) -> Result<Vec<JetCellInput>, Aggre
             materials.push(&p.material.0.name);
         }
     }
-    let varies = |f: fn(&JetParams) -> f64| {
+    let varies = |f: Field| {
         groups
             .iter()
             .any(|(p, _)| f(p).to_bits() != f(groups[0].0).to_bits())

@@ -5,6 +5,7 @@ use rayon::prelude::*;
 
 use super::{BodyConst, ParTasks};
 use crate::body::Body;
+use crate::material::{Fracture, Strength};
 use crate::math::Matrix;
 use crate::particles::{von_mises, Particles};
 use crate::physics;
@@ -57,13 +58,13 @@ pub(crate) fn stress(
                         *s = s_trial;
                         0.0
                     }
-                    Some(jc) => {
+                    Some(Strength::JohnsonCook(jc)) => {
                         let r = physics::radial_return(s_trial, c.shear, jc, *ep, dt, *temp);
                         *s = r.sdev;
                         *epr = r.d_eps / dt;
                         if r.d_eps > 0.0 {
                             let wp = r.sigma_y * r.d_eps; // plastic work per volume
-                            if let Some(dm) = &mat.damage {
+                            if let Some(Fracture::JohnsonCook(dm)) = &mat.damage {
                                 let seq = von_mises(&r.sdev);
                                 let pr = c.pressure(*rho, rho0);
                                 let triax = if seq > 0.0 { -pr / seq } else { 0.0 };

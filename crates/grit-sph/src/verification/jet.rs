@@ -327,7 +327,7 @@ mod tests {
     #[test]
     fn every_row_meets_its_tolerance() {
         let rep = run(1.0, 12, 100, (16, 400.0), (16, 500.0)).unwrap();
-        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 2 + 6);
+        assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 3 + 6);
         for r in &rep.rows {
             assert!(
                 r.pass != r.expected_fail,
@@ -338,7 +338,7 @@ mod tests {
             );
             assert!(r.case.starts_with("jet_"));
         }
-        assert_eq!(rep.charts.len(), 5);
+        assert_eq!(rep.charts.len(), 6);
     }
 
     #[test]
