@@ -347,11 +347,7 @@ impl CampaignSpec {
     /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
     /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
     pub fn from_json(text: &str) -> Result<CampaignSpec, SpecError> {
-        let v: Value = serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))?;
-        let Value::Object(map) = v else {
-            return Err(err("(campaign)", "must be a JSON object"));
-        };
-        Self::from_map(map)
+        Self::from_map(json::spec_object(text)?)
     }
 
     /// Parses the spec's JSON object (see [`CampaignSpec::from_json`]).

@@ -17,7 +17,7 @@ use grit_sph::PenaltyParams;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use super::json::{count, field_path, reject_unknown};
+use super::json::{self, count, field_path, reject_unknown};
 use super::{err, job_seed, MaterialSpec, SpecError, Sweep, MAX_JOBS};
 use crate::jet::JetParams;
 
@@ -182,11 +182,7 @@ impl JetCampaignSpec {
     /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
     /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
     pub fn from_json(text: &str) -> Result<JetCampaignSpec, SpecError> {
-        let v: Value = serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))?;
-        let Value::Object(map) = v else {
-            return Err(err("(campaign)", "must be a JSON object"));
-        };
-        Self::from_map(map)
+        Self::from_map(json::spec_object(text)?)
     }
 
     /// Parses the spec's JSON object (see [`JetCampaignSpec::from_json`]).

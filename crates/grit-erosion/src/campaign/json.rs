@@ -201,6 +201,15 @@ fn field_names<T: DeserializeOwned>() -> &'static [&'static str] {
     names
 }
 
+/// The JSON object of a spec's text; errors name `(json)` for text that is not JSON and
+/// `(campaign)` for JSON that is not an object.
+pub(super) fn spec_object(text: &str) -> Result<Map<String, Value>, SpecError> {
+    match serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))? {
+        Value::Object(map) => Ok(map),
+        _ => Err(err("(campaign)", "must be a JSON object")),
+    }
+}
+
 /// Every key of `map` that is not a field of `T`, named together with the known ones, so a
 /// user sees all their typos at once (serde stops at the first).
 pub(super) fn reject_unknown<T: DeserializeOwned>(

@@ -15,6 +15,14 @@ use crate::api::{
 };
 use crate::error::{Error, Result};
 
+/// Which job a set of stored records belongs to.
+pub(super) struct JobKey {
+    pub cell: u32,
+    pub sample: u32,
+    pub seed: u64,
+    pub state: String,
+}
+
 /// Window over which the impact rate (and so the ETA) is measured.
 const RATE_WINDOW_MS: i64 = 120_000;
 
@@ -389,6 +397,29 @@ impl Store {
     }
 
     async fn raw_series(&self, id: Uuid) -> Result<Vec<RawSample>> {
+        let jobs = self
+            .job_records::<ImpactRecord>(id, "impacts", "impact")
+            .await?;
+        Ok(jobs
+            .into_iter()
+            .map(|(j, impacts)| RawSample {
+                cell: j.cell,
+                sample: j.sample,
+                seed: j.seed,
+                state: j.state,
+                impacts,
+            })
+            .collect())
+    }
+
+    /// Every job of campaign `id` in cell and sample order, with the records it stored in
+    /// `table` (`impacts` or `slices`, ordered by their `unit` column) parsed as `T`.
+    pub(super) async fn job_records<T: serde::de::DeserializeOwned>(
+        &self,
+        id: Uuid,
+        table: &str,
+        unit: &str,
+    ) -> Result<Vec<(JobKey, Vec<T>)>> {
         let jobs = sqlx::query(
             "SELECT id, cell_index, sample_index, seed, state FROM jobs
              WHERE campaign_id = ? ORDER BY cell_index, sample_index",
@@ -396,27 +427,32 @@ impl Store {
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let rows = sqlx::query(
-            "SELECT i.job_id, i.record FROM impacts i JOIN jobs j ON j.id = i.job_id
-             WHERE j.campaign_id = ? ORDER BY i.job_id, i.impact",
-        )
+        let rows = sqlx::query(&format!(
+            "SELECT r.job_id, r.record FROM {table} r JOIN jobs j ON j.id = r.job_id
+             WHERE j.campaign_id = ? ORDER BY r.job_id, r.{unit}"
+        ))
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let mut records: BTreeMap<i64, Vec<ImpactRecord>> = BTreeMap::new();
+        let mut records: BTreeMap<i64, Vec<T>> = BTreeMap::new();
         for r in rows {
-            let rec: ImpactRecord = serde_json::from_str(&r.get::<String, _>(1))
-                .map_err(|e| Error::Internal(format!("stored impact record: {e}")))?;
+            let rec: T = serde_json::from_str(&r.get::<String, _>(1))
+                .map_err(|e| Error::Internal(format!("stored {unit} record: {e}")))?;
             records.entry(r.get(0)).or_default().push(rec);
         }
         Ok(jobs
             .iter()
-            .map(|j| RawSample {
-                cell: j.get::<i64, _>("cell_index") as u32,
-                sample: j.get::<i64, _>("sample_index") as u32,
-                seed: j.get::<i64, _>("seed") as u64,
-                state: j.get("state"),
-                impacts: records.remove(&j.get::<i64, _>("id")).unwrap_or_default(),
+            .map(|j| {
+                let key = JobKey {
+                    cell: j.get::<i64, _>("cell_index") as u32,
+                    sample: j.get::<i64, _>("sample_index") as u32,
+                    seed: j.get::<i64, _>("seed") as u64,
+                    state: j.get("state"),
+                };
+                (
+                    key,
+                    records.remove(&j.get::<i64, _>("id")).unwrap_or_default(),
+                )
             })
             .collect())
     }

@@ -182,34 +182,15 @@ impl Store {
     }
 
     async fn raw_slices(&self, id: Uuid) -> Result<Vec<RawJetSample>> {
-        let jobs = sqlx::query(
-            "SELECT id, cell_index, sample_index, seed, state FROM jobs
-             WHERE campaign_id = ? ORDER BY cell_index, sample_index",
-        )
-        .bind(id.to_string())
-        .fetch_all(&self.read)
-        .await?;
-        let rows = sqlx::query(
-            "SELECT s.job_id, s.record FROM slices s JOIN jobs j ON j.id = s.job_id
-             WHERE j.campaign_id = ? ORDER BY s.job_id, s.slice",
-        )
-        .bind(id.to_string())
-        .fetch_all(&self.read)
-        .await?;
-        let mut records: BTreeMap<i64, Vec<JetSlice>> = BTreeMap::new();
-        for r in rows {
-            let rec: JetSlice = serde_json::from_str(&r.get::<String, _>(1))
-                .map_err(|e| Error::Internal(format!("stored slice record: {e}")))?;
-            records.entry(r.get(0)).or_default().push(rec);
-        }
+        let jobs = self.job_records::<JetSlice>(id, "slices", "slice").await?;
         Ok(jobs
-            .iter()
-            .map(|j| RawJetSample {
-                cell: j.get::<i64, _>("cell_index") as u32,
-                sample: j.get::<i64, _>("sample_index") as u32,
-                seed: j.get::<i64, _>("seed") as u64,
-                state: j.get("state"),
-                slices: records.remove(&j.get::<i64, _>("id")).unwrap_or_default(),
+            .into_iter()
+            .map(|(j, slices)| RawJetSample {
+                cell: j.cell,
+                sample: j.sample,
+                seed: j.seed,
+                state: j.state,
+                slices,
             })
             .collect())
     }
