@@ -345,7 +345,7 @@ fn spec_field(params_field: &str, sweeps: &[(&str, usize, bool)]) -> String {
 
 impl CampaignSpec {
     /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
-    /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
+    /// `(campaign)` for JSON that is not an object, `null` included).
     pub fn from_json(text: &str) -> Result<CampaignSpec, SpecError> {
         Self::from_map(json::spec_object(text)?)
     }

@@ -180,7 +180,7 @@ type Dims = [(&'static str, usize); 6];
 
 impl JetCampaignSpec {
     /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
-    /// `(campaign)` for JSON that is not an object). A top-level `null` means the default.
+    /// `(campaign)` for JSON that is not an object, `null` included).
     pub fn from_json(text: &str) -> Result<JetCampaignSpec, SpecError> {
         Self::from_map(json::spec_object(text)?)
     }
