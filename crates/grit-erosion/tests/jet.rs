@@ -81,6 +81,28 @@ fn the_feed_spaces_grains_for_the_mass_flow() {
         (fed - expected).abs() <= 1.0,
         "fed {fed}, expected {expected:.2}"
     );
+    // Grains leaving slower than the water: the same grains at the same times, so the same M,
+    // each at half the speed and half as far from the nozzle.
+    let half = JetParams {
+        grain_speed_ratio: 0.5,
+        ..p.clone()
+    };
+    let mut slow = JetRun::new(half, 9).unwrap();
+    slow.run_next_slice().unwrap();
+    assert_eq!(slow.slices()[0].grains_fed as f64, fed);
+    let speeds = |r: &JetRun| -> Vec<f64> {
+        r.world()
+            .abrasives()
+            .map(|a| a.dem.grains.iter().map(|g| -g.vel.y).collect())
+            .unwrap_or_default()
+    };
+    let (fast_v, slow_v) = (speeds(&run), speeds(&slow));
+    assert!(!fast_v.is_empty() && !slow_v.is_empty());
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    assert!(
+        mean(&slow_v) < 0.75 * mean(&fast_v),
+        "{slow_v:?} against {fast_v:?}"
+    );
 }
 
 #[test]
@@ -104,6 +126,9 @@ fn bad_parameters_are_named() {
     let mut p = tiny();
     p.target_width_m = 7e-4;
     assert!(field(p).contains("target_width_m"));
+    let mut p = tiny();
+    p.grain_speed_ratio = 0.0;
+    assert!(field(p).contains("grain_speed_ratio"));
     let err = serde_json::from_str::<JetParams>(r#"{"velocity": 400}"#).unwrap_err();
     assert!(err.to_string().contains("velocity"), "{err}");
     let named: JetParams = serde_json::from_str(r#"{"material": "al6061"}"#).unwrap();

@@ -110,6 +110,8 @@ pub struct JetCampaignSpec {
     pub grain_diameter_m: f64,
     /// Grain density (kg/m³).
     pub grain_density_kg_m3: f64,
+    /// A grain's speed leaving the nozzle over the jet's.
+    pub grain_speed_ratio: f64,
     /// The grains' contact constants.
     pub dem: DemParams,
     /// The grain–target penalty contact.
@@ -139,6 +141,7 @@ impl Default for JetCampaignSpec {
             target_depth_m: p.target_depth_m,
             grain_diameter_m: p.grain_diameter_m,
             grain_density_kg_m3: p.grain_density_kg_m3,
+            grain_speed_ratio: p.grain_speed_ratio,
             dem: p.dem,
             penalty: p.penalty,
         }
@@ -375,6 +378,7 @@ impl JetCampaignSpec {
                     target_depth_m: self.target_depth_m,
                     grain_diameter_m: self.grain_diameter_m,
                     grain_density_kg_m3: self.grain_density_kg_m3,
+                    grain_speed_ratio: self.grain_speed_ratio,
                     dem: self.dem.clone(),
                     penalty: self.penalty,
                 };

@@ -37,7 +37,7 @@ impl Feed {
     }
 
     /// Adds to `world` every grain whose place along the jet has left the nozzle by now
-    /// (the jet has run v_jet · t), moving with the jet at v_jet.
+    /// (the jet has run v_jet · t), moving at `grain_speed_ratio` × v_jet.
     pub fn release(
         &mut self,
         world: &mut World,
@@ -58,9 +58,12 @@ impl Feed {
             if s > travelled {
                 return Ok(());
             }
-            let pos = Vector::new((2.0 * w - 1.0) * half, layout.nozzle_y_m - (travelled - s));
+            // Released when the jet had run s, the grain has since moved at its own speed.
+            let ratio = params.grain_speed_ratio;
+            let below = (travelled - s) * ratio;
+            let pos = Vector::new((2.0 * w - 1.0) * half, layout.nozzle_y_m - below);
             let mut g = Grain::sphere(pos, r, params.grain_density_kg_m3);
-            g.vel = Vector::new(0.0, -params.velocity_m_s);
+            g.vel = Vector::new(0.0, -params.velocity_m_s * ratio);
             world.add_grain(g)?;
             self.next += 1;
         }

@@ -52,6 +52,10 @@ pub struct JetParams {
     pub grain_diameter_m: f64,
     /// Grain density (kg/m³; garnet 4120).
     pub grain_density_kg_m3: f64,
+    /// A grain's speed as it leaves the nozzle over v_jet, in (0, 1] (the paper gives none; 1:
+    /// grains move with the water; docs/jet.md#one-grain-in-the-jet). The feed keeps the mass
+    /// flow M of eq. 55 whatever the ratio.
+    pub grain_speed_ratio: f64,
     /// The grains' contact constants (E, ν, restitution e, friction μ).
     pub dem: DemParams,
     /// The grain–target penalty contact (χ, μ).
@@ -74,6 +78,7 @@ impl Default for JetParams {
             target_depth_m: 2e-3,
             grain_diameter_m: 0.2e-3,
             grain_density_kg_m3: 4120.0,
+            grain_speed_ratio: 1.0,
             dem: DemParams::default(),
             penalty: PenaltyParams::default(),
         }
@@ -101,6 +106,12 @@ impl JetParams {
             ("grain_density_kg_m3", self.grain_density_kg_m3),
         ] {
             InputError::require_positive(name, v)?;
+        }
+        if !(self.grain_speed_ratio > 0.0 && self.grain_speed_ratio <= 1.0) {
+            return Err(InputError::new(
+                "grain_speed_ratio",
+                format!("must lie in (0, 1], got {}", self.grain_speed_ratio),
+            ));
         }
         if !(self.mass_flow_kg_s.is_finite() && self.mass_flow_kg_s >= 0.0) {
             return Err(InputError::new(
