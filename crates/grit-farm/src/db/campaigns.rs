@@ -8,7 +8,10 @@ use grit_erosion::{aggregate_campaign, Impact, ImpactRecord, SampleInput};
 use sqlx::Row;
 use uuid::Uuid;
 
-use super::{insert_queued_jobs, now_ms, parse_uuid, NewJob, Store};
+use super::{
+    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, parse_uuid, NewCampaign,
+    NewJob, Store,
+};
 use crate::api::{
     AnyResults, CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress,
     JobCounts, JobError, JobInfo, JobState, RawSample, ResultsResponse,
@@ -59,9 +62,7 @@ impl Store {
         let jobs_total = cells.len() as u64 * samples as u64;
         let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
         let mut tx = self.begin().await?;
-        if let Some(id) =
-            super::jet::by_idempotency_key(&mut tx, idempotency_key, &spec_json).await?
-        {
+        if let Some(id) = by_idempotency_key(&mut tx, idempotency_key, &spec_json).await? {
             return Ok(CampaignCreated {
                 id,
                 jobs: jobs_total,
@@ -71,22 +72,21 @@ impl Store {
         }
         let id = Uuid::new_v4();
         let now = now_ms();
-        let seq: i64 = sqlx::query(
-            "INSERT INTO campaigns (id, name, spec, samples, impacts_total, max_attempts,
-                                    idempotency_key, created_ms)
-             VALUES (?, ?, ?, ?, ?, ?, ?, ?) RETURNING rowid",
+        let seq = insert_campaign(
+            &mut tx,
+            NewCampaign {
+                id,
+                scene: Scene::Impact,
+                name: spec.name.as_deref(),
+                spec_json: &spec_json,
+                samples,
+                units_total: impacts_total,
+                max_attempts: self.max_attempts,
+                idempotency_key,
+                now,
+            },
         )
-        .bind(id.to_string())
-        .bind(&spec.name)
-        .bind(&spec_json)
-        .bind(samples as i64)
-        .bind(impacts_total as i64)
-        .bind(self.max_attempts as i64)
-        .bind(idempotency_key)
-        .bind(now)
-        .fetch_one(&mut *tx)
-        .await?
-        .get(0);
+        .await?;
         for cell in &cells {
             sqlx::query(
                 "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, impacts, params,

@@ -1,7 +1,6 @@
 //! What the coordinator checks an uploaded checkpoint against before any write: the scene
 //! and seed of the job it is sent for (read-only, beside the writer).
 
-use grit_erosion::ImpactParams;
 use sqlx::Row;
 
 use super::Store;
@@ -9,24 +8,6 @@ use crate::checkpoint::JobParams;
 use crate::error::{Error, Result};
 
 impl Store {
-    /// The impact scene and seed of job `job_id`, which its checkpoints must hold; 404 when
-    /// there is no such job.
-    pub async fn job_scene(&self, job_id: i64) -> Result<(ImpactParams, u64)> {
-        let r = sqlx::query(
-            "SELECT c.params, j.seed FROM jobs j
-             JOIN cells c ON c.campaign_id = j.campaign_id AND c.cell_index = j.cell_index
-             WHERE j.id = ?",
-        )
-        .bind(job_id)
-        .fetch_optional(&self.read)
-        .await?
-        .ok_or_else(|| Error::NotFound(format!("job {job_id}")))?;
-        let params: String = r.get(0);
-        let params = serde_json::from_str(&params)
-            .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))?;
-        Ok((params, r.get::<i64, _>(1) as u64))
-    }
-
     /// The scene (impact or jet) and seed of job `job_id`, which its checkpoints must hold;
     /// 404 when there is no such job.
     pub async fn job_params(&self, job_id: i64) -> Result<(JobParams, u64)> {

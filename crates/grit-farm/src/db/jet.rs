@@ -3,13 +3,15 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{job_seed, JetCampaignSpec};
+use grit_erosion::campaign::{job_seed, JetCampaignSpec, Scene};
 use grit_erosion::jet::aggregate::{aggregate_jet_campaign, JetCellInput, JetSampleInput};
 use grit_erosion::jet::JetSlice;
-use sqlx::{Row, Sqlite, Transaction};
+use sqlx::Row;
 use uuid::Uuid;
 
-use super::{insert_queued_jobs, now_ms, parse_uuid, NewJob, Store};
+use super::{
+    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, NewCampaign, NewJob, Store,
+};
 use crate::api::{CampaignCreated, JetResultsResponse, RawJetSample};
 use crate::error::{Error, Result};
 
@@ -17,32 +19,6 @@ use crate::error::{Error, Result};
 const JET_ANGLE_DEG: f64 = 90.0;
 /// What a jet cell stores as its shape: the scene's name.
 const JET_SHAPE: &str = "jet";
-
-/// The campaign stored under `key`, if any: its id when its spec is `spec_json`, a 409 when
-/// the key was used for another spec.
-pub(super) async fn by_idempotency_key(
-    tx: &mut Transaction<'static, Sqlite>,
-    key: Option<&str>,
-    spec_json: &str,
-) -> Result<Option<Uuid>> {
-    let Some(key) = key else {
-        return Ok(None);
-    };
-    let row = sqlx::query("SELECT id, spec FROM campaigns WHERE idempotency_key = ?")
-        .bind(key)
-        .fetch_optional(&mut **tx)
-        .await?;
-    let Some(row) = row else {
-        return Ok(None);
-    };
-    let old: String = row.get("spec");
-    if old != spec_json {
-        return Err(Error::Conflict(
-            "Idempotency-Key already used for a different campaign".into(),
-        ));
-    }
-    Ok(Some(parse_uuid(&row.get::<String, _>("id"))?))
-}
 
 fn internal(e: impl std::fmt::Display) -> Error {
     Error::Internal(e.to_string())
@@ -73,22 +49,21 @@ impl Store {
         }
         let id = Uuid::new_v4();
         let now = now_ms();
-        let seq: i64 = sqlx::query(
-            "INSERT INTO campaigns (id, name, spec, samples, impacts_total, max_attempts,
-                                    idempotency_key, created_ms, scene)
-             VALUES (?, ?, ?, ?, ?, ?, ?, ?, 'jet') RETURNING rowid",
+        let seq = insert_campaign(
+            &mut tx,
+            NewCampaign {
+                id,
+                scene: Scene::Jet,
+                name: spec.name.as_deref(),
+                spec_json: &spec_json,
+                samples,
+                units_total: slices_total,
+                max_attempts: self.max_attempts,
+                idempotency_key,
+                now,
+            },
         )
-        .bind(id.to_string())
-        .bind(&spec.name)
-        .bind(&spec_json)
-        .bind(samples as i64)
-        .bind(slices_total as i64)
-        .bind(self.max_attempts as i64)
-        .bind(idempotency_key)
-        .bind(now)
-        .fetch_one(&mut *tx)
-        .await?
-        .get(0);
+        .await?;
         for cell in &cells {
             sqlx::query(
                 "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, impacts,

@@ -10,10 +10,11 @@ use std::path::Path;
 use std::str::FromStr;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
+use grit_erosion::campaign::Scene;
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
 };
-use sqlx::{Sqlite, Transaction};
+use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
 use crate::error::{Error, Result};
@@ -162,6 +163,70 @@ async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool>
 /// Parses a uuid the store wrote.
 fn parse_uuid(s: &str) -> Result<Uuid> {
     Uuid::from_str(s).map_err(|e| Error::Internal(format!("stored id {s}: {e}")))
+}
+
+/// The campaign stored under `key`, if any: its id when its spec is `spec_json`, a 409 when
+/// the key was used for another spec.
+pub(crate) async fn by_idempotency_key(
+    tx: &mut Transaction<'static, Sqlite>,
+    key: Option<&str>,
+    spec_json: &str,
+) -> Result<Option<Uuid>> {
+    let Some(key) = key else {
+        return Ok(None);
+    };
+    let row = sqlx::query("SELECT id, spec FROM campaigns WHERE idempotency_key = ?")
+        .bind(key)
+        .fetch_optional(&mut **tx)
+        .await?;
+    let Some(row) = row else {
+        return Ok(None);
+    };
+    let old: String = row.get("spec");
+    if old != spec_json {
+        return Err(Error::Conflict(
+            "Idempotency-Key already used for a different campaign".into(),
+        ));
+    }
+    Ok(Some(parse_uuid(&row.get::<String, _>("id"))?))
+}
+
+/// A campaign row to insert: everything but its cells and jobs.
+pub(crate) struct NewCampaign<'a> {
+    pub id: Uuid,
+    pub scene: Scene,
+    pub name: Option<&'a str>,
+    pub spec_json: &'a str,
+    pub samples: u32,
+    /// Impacts, or slices for a jet campaign, over all jobs.
+    pub units_total: u64,
+    pub max_attempts: u32,
+    pub idempotency_key: Option<&'a str>,
+    pub now: i64,
+}
+
+/// Inserts the campaign row `c`; returns its rowid, the `seq` its jobs carry.
+pub(crate) async fn insert_campaign(
+    tx: &mut Transaction<'static, Sqlite>,
+    c: NewCampaign<'_>,
+) -> Result<i64> {
+    Ok(sqlx::query(
+        "INSERT INTO campaigns (id, name, spec, samples, impacts_total, max_attempts,
+                                idempotency_key, created_ms, scene)
+         VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING rowid",
+    )
+    .bind(c.id.to_string())
+    .bind(c.name)
+    .bind(c.spec_json)
+    .bind(c.samples as i64)
+    .bind(c.units_total as i64)
+    .bind(c.max_attempts as i64)
+    .bind(c.idempotency_key)
+    .bind(c.now)
+    .bind(c.scene.as_str())
+    .fetch_one(&mut **tx)
+    .await?
+    .get(0))
 }
 
 /// A job row to insert as queued: (cell, sample, impacts planned, seed).
