@@ -226,29 +226,23 @@ pub struct WallLoad {
     pub force: Vector,
 }
 
-/// Per body, Σ m a over its kinematic fluid particles, from the pair accelerations of
-/// [`fluid_accelerations`]: the force its fluid puts on its walls (N/m; zero for bodies without
-/// walls), and each wall particle's share in `loads`. Summed serially in particle order, so
-/// the bits do not depend on the thread count.
+/// The force m a of the pair accelerations of [`fluid_accelerations`] on every kinematic fluid
+/// particle (a fluid's walls), in particle order, so sums over them do not depend on the
+/// thread count.
 pub(crate) fn wall_forces(
     p: &Particles,
     bc: &[BodyConst],
     accel: &[Vector],
-    out: &mut Vec<Vector>,
     loads: &mut Vec<WallLoad>,
 ) {
-    out.clear();
-    out.resize(bc.len(), Vector::zeros());
     loads.clear();
     for (i, a) in accel.iter().enumerate().take(p.len()) {
         let b = p.body[i] as usize;
         if bc[b].fluid.is_some() && p.flags[i] & KINEMATIC != 0 {
-            let force = a * p.mass[i];
-            out[b] += force;
             loads.push(WallLoad {
                 body: b as u32,
                 position: p.pos[i],
-                force,
+                force: a * p.mass[i],
             });
         }
     }

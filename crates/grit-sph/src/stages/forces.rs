@@ -132,6 +132,8 @@ pub(crate) fn forces(
                     // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
                     // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
                     let rr = r.max(HG_MIN_SEPARATION_H * h);
+                    // Not the kernel sums' volumes: the stress stage has moved ρ since
+                    // (continuity), and both volumes must be the same step's.
                     let cij = alpha * vol[i] * vol[j] * pair.w / (rr * rr);
                     hourglass = e * (cij * 0.5 * (stiff + visc));
                 }

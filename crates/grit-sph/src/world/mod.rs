@@ -49,9 +49,7 @@ struct Scratch {
     contact_force: Vec<Vector>,
     /// Continuity rates dρ̄/dt of the fluid particles (the fluid stage fills it).
     drho: Vec<f64>,
-    /// Per body, the force the fluid's pair terms put on its kinematic particles.
-    wall_force: Vec<Vector>,
-    /// The same force per wall particle.
+    /// The force the fluids' pair terms put on each of their kinematic particles.
     wall_loads: Vec<WallLoad>,
     /// Porosity ε of every particle (eq. 20; 1 away from grains), for the coupling's averages
     /// and drag (the fluid's EOS reads ρ̄ alone: docs/jet.md#porosity-and-the-eos).
@@ -195,10 +193,10 @@ impl World {
     /// walls. Zero before the first step and for other bodies.
     pub fn wall_force(&self, b: usize) -> Vector {
         self.scratch
-            .wall_force
-            .get(b)
-            .copied()
-            .unwrap_or_else(Vector::zeros)
+            .wall_loads
+            .iter()
+            .filter(|l| l.body as usize == b)
+            .fold(Vector::zeros(), |sum, l| sum + l.force)
     }
     /// The fluids' loads on each of their wall particles in the last step (N/m), in particle
     /// order: the pressure distribution along a wall ([`World::wall_force`] is their sum per
@@ -534,7 +532,7 @@ impl World {
                 let cross = &self.nbrs.cross;
                 stages::interface_forces(s, cross, state, av, &mut sc.acc, &mut sc.theta);
             }
-            stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_force, &mut sc.wall_loads);
+            stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_loads);
         }
     }
 
