@@ -89,6 +89,50 @@ fn bad_jet_input_names_the_field_and_exits_non_zero() {
 }
 
 #[test]
+fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
+    let out = grit(&[
+        "study",
+        "rc",
+        "--across",
+        "8",
+        "--jet-speed-m-s",
+        "300",
+        "--rc",
+        "2",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["scene"]["jet_speed_m_s"], 300.0);
+    let rides = v["rides"].as_array().unwrap();
+    assert_eq!(rides.len(), 1);
+    assert_eq!(rides[0]["label"], "R_c = 2 d");
+    // The grain is braked in the stagnation zone, never sped up past the jet.
+    let speed = rides[0]["contact_speed_m_s"].as_f64().unwrap();
+    assert!(speed > 0.0 && speed < 300.0, "{speed}");
+    for (args, needle) in [
+        (vec!["--across", "7"], "--across"),
+        (vec!["--jet-speed-m-s=-1"], "--jet-speed-m-s"),
+        (vec!["--release-ratio", "3"], "--release-ratio"),
+        (vec!["--rc", "0"], "--rc"),
+        // 8 across is 0.125 mm per particle: too coarse to resolve a 0.2 mm grain.
+        (
+            vec!["--across", "8", "--rc", "2", "--resolved"],
+            "finer spacing",
+        ),
+    ] {
+        let out = grit(&[&["study", "rc"], &args[..]].concat());
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn grit_plot_gathers_jet_run_files_into_a_campaign() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("scene.json");

@@ -2,7 +2,9 @@
 
 use std::process::ExitCode;
 
+use anyhow::bail;
 use grit_erosion::studies::settle::{settle_study, SettleRow};
+use grit_sph::verification::jet_grain::{self, GrainRide, RcScene};
 
 use super::output::say;
 use super::sample::SceneArgs;
@@ -17,6 +19,38 @@ pub struct StudyArgs {
 
 #[derive(clap::Subcommand)]
 enum Study {
+    /// The AWJ paper's coupling-radius study: one grain rides a settled jet onto a rigid wall,
+    /// unresolved at each coupling radius and, with --resolved, fully resolved; prints each
+    /// grain's speed at contact (docs/jet.md#one-grain-in-the-jet).
+    #[command(
+        after_help = "Example: grit study rc --across 32 --jet-speed-m-s 500 --release-ratio 1 --resolved"
+    )]
+    Rc {
+        /// Water particles across the 1 mm jet (even; the resolved grain wants 24 or more).
+        #[arg(long, default_value_t = 16)]
+        across: usize,
+        /// The jet's speed (m/s).
+        #[arg(long, default_value_t = 500.0)]
+        jet_speed_m_s: f64,
+        /// The grain's speed at release over the jet's (0: at rest).
+        #[arg(long, default_value_t = 1.0)]
+        release_ratio: f64,
+        /// Coupling radii R_c/d of the unresolved grains, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,1.5,2,2.5,3")]
+        rc: Vec<f64>,
+        /// Also ride a fully resolved grain (an elastic garnet disc of the water's spacing).
+        #[arg(long)]
+        resolved: bool,
+        /// Write the grains' speed against time as an SVG chart here.
+        #[arg(long)]
+        chart: Option<std::path::PathBuf>,
+        /// Worker threads of the engine (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print {scene, rides: [{label, contact_speed_m_s}]} as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Runs a sample and each of its impacts again, from the same surface, with a stricter end
     /// criterion: mass loss and damage must not depend on when an impact ends.
     #[command(
@@ -46,6 +80,68 @@ enum Study {
 /// Runs one of the checks of the scene's own choices.
 pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
     match a.study {
+        Study::Rc {
+            across,
+            jet_speed_m_s,
+            release_ratio,
+            rc,
+            resolved,
+            chart,
+            threads,
+            json,
+        } => {
+            let scene = RcScene {
+                across,
+                jet_speed_m_s,
+                release_ratio,
+            };
+            check_rc_scene(&scene, &rc)?;
+            let rides = pool(threads)?.install(|| -> anyhow::Result<Vec<GrainRide>> {
+                eprintln!(
+                    "settling the jet and riding {} grain(s) ...",
+                    rc.len() + usize::from(resolved)
+                );
+                let jet = jet_grain::settled_jet(across, jet_speed_m_s)?;
+                let v = scene.release_speed();
+                let mut rides = rc
+                    .iter()
+                    .map(|&f| jet_grain::ride(&jet, v, f))
+                    .collect::<Result<Vec<_>, _>>()?;
+                if resolved {
+                    rides.push(jet_grain::ride_resolved(&jet, v)?);
+                }
+                Ok(rides)
+            })?;
+            if let Some(path) = &chart {
+                super::plot::line_chart(&jet_grain::rides_chart(&scene, &rides), path)?;
+                eprintln!("wrote {}", path.display());
+            }
+            if json {
+                let rides: Vec<_> = rides
+                    .iter()
+                    .map(|r| serde_json::json!({"label": r.label, "contact_speed_m_s": r.contact_speed_m_s}))
+                    .collect();
+                let scene = serde_json::json!({
+                    "across": across,
+                    "jet_speed_m_s": jet_speed_m_s,
+                    "release_ratio": release_ratio,
+                });
+                say!(
+                    "{}",
+                    serde_json::to_string_pretty(
+                        &serde_json::json!({"scene": scene, "rides": rides})
+                    )?
+                );
+                return Ok(ExitCode::SUCCESS);
+            }
+            say!("jet {jet_speed_m_s} m/s, b/dx {across}, grain released at {release_ratio} x the jet's speed");
+            say!("{:<14} {:>18}", "grain", "contact speed m/s");
+            for r in &rides {
+                say!("{:<14} {:>18.1}", r.label, r.contact_speed_m_s);
+            }
+            say!("the paper: 166 m/s unresolved at R_c = 2.0 d, 162 m/s resolved");
+            Ok(ExitCode::SUCCESS)
+        }
         Study::Settle {
             scene,
             impacts,
@@ -90,4 +186,30 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// Refuses a coupling-radius scene the study cannot run, naming the flag and the rule.
+fn check_rc_scene(scene: &RcScene, rc: &[f64]) -> anyhow::Result<()> {
+    if scene.across < 2 || !scene.across.is_multiple_of(2) {
+        bail!(
+            "--across: must be an even number >= 2, got {}",
+            scene.across
+        );
+    }
+    if !(scene.jet_speed_m_s.is_finite() && scene.jet_speed_m_s > 0.0) {
+        bail!(
+            "--jet-speed-m-s: must be a finite number > 0, got {}",
+            scene.jet_speed_m_s
+        );
+    }
+    if !(scene.release_ratio.is_finite() && (0.0..=2.0).contains(&scene.release_ratio)) {
+        bail!(
+            "--release-ratio: must lie in [0, 2], got {}",
+            scene.release_ratio
+        );
+    }
+    if let Some(f) = rc.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        bail!("--rc: every coupling radius must be a finite number > 0, got {f}");
+    }
+    Ok(())
 }

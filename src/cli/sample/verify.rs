@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use grit_sph::verification::{
-    elastic_impact, hertz, hourglass, jet, sliding, slope, CaseReport, Row,
+    elastic_impact, hertz, hourglass, jet, jet_grain, sliding, slope, CaseReport, Row,
 };
 
 use crate::cli::output::say;
@@ -57,7 +57,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     };
     let wall = if a.quick { (16, 400.0) } else { (24, 400.0) };
     // The coupling-radius study's jet: the paper's d_ini = 50 µm is 20 across its 1 mm jet.
-    let rc = if a.quick { (16, 500.0) } else { (20, 500.0) };
+    let rc = jet_grain::RcScene {
+        across: if a.quick { 16 } else { 20 },
+        jet_speed_m_s: 500.0,
+        release_ratio: 1.0,
+    };
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [

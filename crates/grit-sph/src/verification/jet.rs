@@ -32,13 +32,13 @@ const TOL_RESTITUTION: f64 = 0.02;
 /// Runs all rows; the DEM steps are `dt_scale` × `Dem::time_step()`, the water column is
 /// `hydro_n` particles high, the settling grain takes `settle_steps` steps per Stokes time, and
 /// the jet on a wall has `wall_n` particles across at `wall_speed` m/s, and the grain's jet
-/// (the coupling-radius study) `rc_n` across at `rc_speed` m/s.
+/// (the coupling-radius study) is `rc`.
 pub fn run(
     dt_scale: f64,
     hydro_n: usize,
     settle_steps: usize,
     (wall_n, wall_speed): (usize, f64),
-    (rc_n, rc_speed): (usize, f64),
+    rc: super::jet_grain::RcScene,
 ) -> Result<CaseReport, SimError> {
     let mut rep = hugoniot()?;
     rep.extend(dem_drop(dt_scale)?);
@@ -48,7 +48,7 @@ pub fn run(
     rep.extend(super::hydrostatic::hydrostatic(hydro_n)?);
     rep.extend(super::settling::settling(settle_steps)?);
     rep.extend(super::jet_wall::jet_wall(wall_n, wall_speed)?);
-    rep.extend(super::jet_grain::rc_study(rc_n, rc_speed)?);
+    rep.extend(super::jet_grain::rc_study(rc)?);
     Ok(rep)
 }
 
@@ -326,7 +326,12 @@ mod tests {
 
     #[test]
     fn every_row_meets_its_tolerance() {
-        let rep = run(1.0, 12, 100, (16, 400.0), (16, 500.0)).unwrap();
+        let rc = super::super::jet_grain::RcScene {
+            across: 16,
+            jet_speed_m_s: 500.0,
+            release_ratio: 1.0,
+        };
+        let rep = run(1.0, 12, 100, (16, 400.0), rc).unwrap();
         assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 3 + 6);
         for r in &rep.rows {
             assert!(

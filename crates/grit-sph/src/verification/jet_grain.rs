@@ -14,6 +14,8 @@ use crate::coupling::CouplingParams;
 use crate::dem::{Dem, DemParams, Grain, Wall};
 use crate::error::SimError;
 use crate::fluid::Fluid;
+use crate::geometry::Polygon;
+use crate::material::Material;
 use crate::math::Vector;
 use crate::world::{Abrasives, PenaltyParams, World};
 
@@ -33,8 +35,8 @@ const TOL_CONTACT: f64 = 0.05;
 /// What one grain's ride measured.
 #[derive(Debug, Clone)]
 pub struct GrainRide {
-    /// R_c / d.
-    pub rc_over_d: f64,
+    /// How the grain met the water: `R_c = … d` (unresolved) or `resolved`.
+    pub label: String,
     /// The grain's speed at its first contact with the wall (m/s).
     pub contact_speed_m_s: f64,
     /// Time since release (µs) and the grain's downward speed (m/s), every step.
@@ -51,9 +53,59 @@ pub fn settled_jet(n: usize, speed: f64) -> Result<World, SimError> {
     Ok(world)
 }
 
-/// Releases one grain into a copy of the settled jet `jet` with coupling radius `rc_over_d` d
+/// The height of the nozzle's exit in `jet` (m).
+fn nozzle_top(jet: &World) -> Result<f64, SimError> {
+    jet.inflows()
+        .first()
+        .map(|i| i.nozzle.centre_m.y)
+        .ok_or_else(|| fail("jet_grain: the jet has no nozzle".into()))
+}
+
+/// Steps `w` until the grain whose centre and velocity `grain` reads touches the wall (its centre
+/// within `contact_gap` of one radius above the wall's surface), recording its downward speed;
+/// `label` names the ride.
+fn follow(
+    mut w: World,
+    release_speed: f64,
+    label: String,
+    contact_gap: f64,
+    grain: impl Fn(&World) -> Option<(Vector, Vector)>,
+) -> Result<GrainRide, SimError> {
+    let r = 0.5 * GRAIN_D;
+    let top = nozzle_top(&w)?;
+    let t0 = w.time();
+    let mut trace = (Vec::new(), Vec::new());
+    // A grain slower than a tenth of the jet's speed is stuck, not riding.
+    let t_max = t0 + 10.0 * top / release_speed.max(0.1 * w.inflows()[0].nozzle.speed_m_s);
+    loop {
+        w.step()?;
+        let Some((pos, vel)) = grain(&w) else {
+            return Err(fail(format!(
+                "jet_grain: the grain left the scene ({label})"
+            )));
+        };
+        trace.0.push((w.time() - t0) * 1e6);
+        trace.1.push(-vel.y);
+        if pos.y <= r + contact_gap {
+            return Ok(GrainRide {
+                label,
+                contact_speed_m_s: vel.norm(),
+                trace,
+            });
+        }
+        if w.time() > t_max {
+            return Err(fail(format!(
+                "jet_grain: no contact within {:.2e} s ({label})",
+                t_max - t0
+            )));
+        }
+    }
+}
+
+/// Releases one unresolved grain (a DEM sphere meeting the water through the coupling) at
+/// `release_speed` m/s into a copy of the settled jet `jet`, with coupling radius `rc_over_d` d,
 /// and follows it to the wall.
-pub fn ride(jet: &World, speed: f64, rc_over_d: f64) -> Result<GrainRide, SimError> {
+pub fn ride(jet: &World, release_speed: f64, rc_over_d: f64) -> Result<GrainRide, SimError> {
     let mut w = jet.clone();
     let err = |e: crate::error::InputError| fail(format!("jet_grain: {e}"));
     let floor = Wall::new(Vector::zeros(), Vector::new(0.0, 1.0)).map_err(err)?;
@@ -76,39 +128,84 @@ pub fn ride(jet: &World, speed: f64, rc_over_d: f64) -> Result<GrainRide, SimErr
     ))
     .map_err(err)?;
     let r = 0.5 * GRAIN_D;
-    let top = jet
-        .inflows()
-        .first()
-        .map(|i| i.nozzle.centre_m.y)
-        .ok_or_else(|| fail("jet_grain: the jet has no nozzle".into()))?;
+    let top = nozzle_top(jet)?;
     let mut g = Grain::sphere(Vector::new(0.0, top - r), r, GRAIN_RHO);
-    g.vel = Vector::new(0.0, -speed);
+    g.vel = Vector::new(0.0, -release_speed);
     w.add_grain(g).map_err(err)?;
-    let t0 = w.time();
-    let mut trace = (Vec::new(), Vec::new());
-    let t_max = t0 + 10.0 * top / speed;
-    loop {
-        w.step()?;
-        let ab = w.abrasives().expect("set above");
-        let Some(g) = ab.dem.grains.first() else {
-            return Err(fail("jet_grain: the grain left the scene".into()));
-        };
-        trace.0.push((w.time() - t0) * 1e6);
-        trace.1.push(-g.vel.y);
-        if g.pos.y <= r {
-            return Ok(GrainRide {
-                rc_over_d,
-                contact_speed_m_s: g.vel.norm(),
-                trace,
-            });
-        }
-        if w.time() > t_max {
-            return Err(fail(format!(
-                "jet_grain: no contact within {:.2e} s at R_c = {rc_over_d} d",
-                t_max - t0
-            )));
-        }
+    follow(w, release_speed, format!("R_c = {rc_over_d} d"), 0.0, |w| {
+        let g = w.abrasives()?.dem.grains.first()?;
+        Some((g.pos, g.vel))
+    })
+}
+
+/// The garnet of the resolved grain: the AWJ paper's E = 248 GPa and ν = 0.3, elastic (the
+/// paper's resolved grain is rigid; at the jet's loads, below 0.5 GPa, this one strains less
+/// than 0.2 %).
+pub fn garnet() -> Material {
+    Material {
+        name: "garnet-elastic".into(),
+        density_kg_m3: GRAIN_RHO,
+        youngs_modulus_pa: 248e9,
+        poisson_ratio: 0.3,
+        heat_capacity_j_kgk: 700.0,
+        plasticity: None,
+        damage: None,
+        eos: None,
     }
+}
+
+/// Releases one fully resolved grain at `release_speed` m/s into a copy of the settled jet
+/// `jet`: a disc of the jet's own spacing, an elastic garnet body the water pushes through the
+/// fluid–solid pair terms (`stages::interface`), with the water particles inside it removed;
+/// its speed is that of its centre of mass. The paper's reference (its Fig. 11, 162 m/s) is such
+/// a grain of many DEM particles.
+pub fn ride_resolved(jet: &World, release_speed: f64) -> Result<GrainRide, SimError> {
+    let mut w = jet.clone();
+    let err = |e: crate::error::InputError| fail(format!("jet_grain: {e}"));
+    let r = 0.5 * GRAIN_D;
+    let dx = w.settings().spacing_m;
+    let centre = Vector::new(0.0, nozzle_top(jet)? - r);
+    // Water closer to the centre than the grain's surface, half a spacing beyond its outermost
+    // particles, would sit inside it.
+    let p = w.particles();
+    let keep: Vec<bool> = (0..p.len())
+        .map(|i| (p.pos[i] - centre).norm() >= r + 0.5 * dx)
+        .collect();
+    w.remove_particles(&keep).map_err(err)?;
+    let disc = Polygon::regular(96, r, 0.0).translated(centre);
+    // Lattice columns at (i + 1/2) dx, as the jet's, so the disc is symmetric about the axis.
+    let origin = Vector::new(0.0, centre.y);
+    let b = w
+        .add_deformable_polygon(
+            "grain",
+            garnet(),
+            &disc,
+            origin,
+            Vector::new(0.0, -release_speed),
+        )
+        .map_err(err)?;
+    if w.particles()
+        .body
+        .iter()
+        .filter(|&&x| x as usize == b)
+        .count()
+        < 7
+    {
+        return Err(fail(format!(
+            "jet_grain: a resolved grain of d = {GRAIN_D} m needs a finer spacing than {dx} m"
+        )));
+    }
+    // Its particles meet the wall's at about a spacing apart: the surfaces then touch.
+    follow(w, release_speed, "resolved".into(), 0.5 * dx, move |w| {
+        let p = w.particles();
+        let (mut m, mut mx, mut mv) = (0.0, Vector::zeros(), Vector::zeros());
+        for i in (0..p.len()).filter(|&i| p.body[i] as usize == b) {
+            m += p.mass[i];
+            mx += p.pos[i] * p.mass[i];
+            mv += p.vel[i] * p.mass[i];
+        }
+        (m > 0.0).then(|| (mx / m, mv / m))
+    })
 }
 
 /// The coupling radii of the study, in grain diameters (the paper's Fig. 11).
@@ -117,24 +214,66 @@ pub const RC_FACTORS: [f64; 5] = [1.0, 1.5, 2.0, 2.5, 3.0];
 /// curves to count as coinciding (ours; the paper says only that they coincide).
 const TOL_COINCIDE: f64 = 0.05;
 
-/// The study's rows, on a jet `n` particles across at `speed` m/s: the contact speed at each
-/// R_c of [`RC_FACTORS`] (2.0 d judged against the paper's 166 m/s within 5 %, and expected to
-/// miss it: docs/jet.md#one-grain-in-the-jet), whether 2.5 d and 3.0 d coincide, and the chart
-/// of the grains' speeds.
-pub fn rc_study(n: usize, speed: f64) -> Result<CaseReport, SimError> {
-    let jet = settled_jet(n, speed)?;
+/// The scene of the coupling-radius study: the jet's particles across its width [`JET_B`], its
+/// speed, and the grain's speed at release over the jet's (the paper gives neither speed: its
+/// Table 4 is not in its text).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RcScene {
+    /// Particles across the jet.
+    pub across: usize,
+    /// The jet's speed (m/s).
+    pub jet_speed_m_s: f64,
+    /// The grain's speed at release over the jet's.
+    pub release_ratio: f64,
+}
+
+impl RcScene {
+    /// The grain's speed at release (m/s).
+    pub fn release_speed(&self) -> f64 {
+        self.release_ratio * self.jet_speed_m_s
+    }
+
+    /// The scene as the rows' resolution column.
+    fn describe(&self) -> String {
+        format!(
+            "b/dx={}, v={} m/s, release {}v",
+            self.across, self.jet_speed_m_s, self.release_ratio
+        )
+    }
+}
+
+/// Unresolved grains released into one settled jet of `scene`, one per coupling radius of
+/// `factors` (in grain diameters).
+pub fn unresolved_rides(scene: RcScene, factors: &[f64]) -> Result<Vec<GrainRide>, SimError> {
+    let jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
+    factors
+        .iter()
+        .map(|&f| ride(&jet, scene.release_speed(), f))
+        .collect()
+}
+
+/// A fully resolved grain ([`ride_resolved`]) released into the settled jet of `scene`.
+pub fn resolved_ride(scene: RcScene) -> Result<GrainRide, SimError> {
+    let jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
+    ride_resolved(&jet, scene.release_speed())
+}
+
+/// The study's rows on `scene`: the contact speed at each R_c of [`RC_FACTORS`] (2.0 d judged
+/// against the paper's 166 m/s within 5 %, and expected to miss it:
+/// docs/jet.md#one-grain-in-the-jet), whether 2.5 d and 3.0 d coincide, and the chart of the
+/// grains' speeds.
+pub fn rc_study(scene: RcScene) -> Result<CaseReport, SimError> {
+    let rides = unresolved_rides(scene, &RC_FACTORS)?;
     let mut rep = CaseReport::default();
-    let mut series = Vec::new();
     let mut contact = Vec::new();
-    for f in RC_FACTORS {
-        let ride = ride(&jet, speed, f)?;
+    for (f, ride) in RC_FACTORS.into_iter().zip(&rides) {
         let v = ride.contact_speed_m_s;
         contact.push(v);
         let err = (v - PAPER_CONTACT_SPEED).abs() / PAPER_CONTACT_SPEED;
         let judged = (f - 2.0).abs() < 1e-9;
         rep.rows.push(Row {
             case: format!("jet_rc_contact_speed_{f:.1}d"),
-            resolution: format!("b/dx={n}, v={speed} m/s"),
+            resolution: scene.describe(),
             value: v,
             reference: PAPER_CONTACT_SPEED,
             error_rel: err,
@@ -142,24 +281,18 @@ pub fn rc_study(n: usize, speed: f64) -> Result<CaseReport, SimError> {
             expected_fail: judged,
             note: if judged {
                 format!(
-                    "grain speed (m/s) at wall contact, R_c = {f} d; paper 166 (resolved 162) at a jet speed its text does not give; bound 5%, missed"
+                    "grain speed (m/s) at wall contact, R_c = {f} d; paper 166 (resolved 162) at a jet speed its text does not give; bound 5%, missed (docs/jet.md#one-grain-in-the-jet)"
                 )
             } else {
                 format!("grain speed (m/s) at wall contact, R_c = {f} d; reported, not judged")
             },
-        });
-        series.push(Series {
-            label: format!("R_c = {f} d"),
-            x: ride.trace.0,
-            y: ride.trace.1,
-            reference: false,
         });
     }
     let (v25, v30) = (contact[3], contact[4]);
     let diff = (v30 - v25).abs() / v25;
     rep.rows.push(Row {
         case: "jet_rc_coincide_2.5d_3.0d".into(),
-        resolution: format!("b/dx={n}, v={speed} m/s"),
+        resolution: scene.describe(),
         value: diff,
         reference: 0.0,
         error_rel: diff,
@@ -167,12 +300,28 @@ pub fn rc_study(n: usize, speed: f64) -> Result<CaseReport, SimError> {
         expected_fail: false,
         note: "|v(3.0 d) - v(2.5 d)| / v(2.5 d) at wall contact; bound 5%".into(),
     });
-    rep.charts.push(Chart {
+    rep.charts.push(rides_chart(&scene, &rides));
+    Ok(rep)
+}
+
+/// The grains' downward speed against the time since release, one line per ride.
+pub fn rides_chart(scene: &RcScene, rides: &[GrainRide]) -> Chart {
+    Chart {
         name: "jet_rc_study".into(),
-        title: format!("One grain in a {speed} m/s jet on a wall (b/dx = {n})"),
+        title: format!(
+            "One grain in a {} m/s jet on a wall (b/dx = {})",
+            scene.jet_speed_m_s, scene.across
+        ),
         x_label: "time since release (µs)".into(),
         y_label: "grain speed towards the wall (m/s)".into(),
-        series,
-    });
-    Ok(rep)
+        series: rides
+            .iter()
+            .map(|r| Series {
+                label: r.label.clone(),
+                x: r.trace.0.clone(),
+                y: r.trace.1.clone(),
+                reference: false,
+            })
+            .collect(),
+    }
 }
