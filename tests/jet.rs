@@ -118,6 +118,7 @@ fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
         (vec!["--across", "7"], "--across"),
         (vec!["--jet-speed-m-s=-1"], "--jet-speed-m-s"),
         (vec!["--release-ratio", "3"], "--release-ratio"),
+        (vec!["--switch-porosity", "1.5"], "--switch-porosity"),
         (vec!["--rc", "0"], "--rc"),
         // 8 across is 0.125 mm per particle: too coarse to resolve a 0.2 mm grain.
         (

@@ -35,6 +35,10 @@ enum Study {
         /// The grain's speed at release over the jet's (0: at rest).
         #[arg(long, default_value_t = 1.0)]
         release_ratio: f64,
+        /// The porosity at and below which the unresolved drag is Ergun's, above it Wen–Yu's
+        /// (the paper's 0.8; eq. 44).
+        #[arg(long, default_value_t = 0.8)]
+        switch_porosity: f64,
         /// Coupling radii R_c/d of the unresolved grains, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "1,1.5,2,2.5,3")]
         rc: Vec<f64>,
@@ -84,6 +88,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             across,
             jet_speed_m_s,
             release_ratio,
+            switch_porosity,
             rc,
             resolved,
             chart,
@@ -91,9 +96,8 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             json,
         } => {
             let scene = RcScene {
-                across,
-                jet_speed_m_s,
-                release_ratio,
+                switch_porosity,
+                ..RcScene::new(across, jet_speed_m_s, release_ratio)
             };
             check_rc_scene(&scene, &rc)?;
             let rides = pool(threads)?.install(|| -> anyhow::Result<Vec<GrainRide>> {
@@ -105,7 +109,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                 let v = scene.release_speed();
                 let mut rides = rc
                     .iter()
-                    .map(|&f| jet_grain::ride(&jet, v, f))
+                    .map(|&f| jet_grain::ride(&jet, &scene, f))
                     .collect::<Result<Vec<_>, _>>()?;
                 if resolved {
                     rides.push(jet_grain::ride_resolved(&jet, v)?);
@@ -125,6 +129,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                     "across": across,
                     "jet_speed_m_s": jet_speed_m_s,
                     "release_ratio": release_ratio,
+                    "switch_porosity": switch_porosity,
                 });
                 say!(
                     "{}",
@@ -206,6 +211,12 @@ fn check_rc_scene(scene: &RcScene, rc: &[f64]) -> anyhow::Result<()> {
         bail!(
             "--release-ratio: must lie in [0, 2], got {}",
             scene.release_ratio
+        );
+    }
+    if !(scene.switch_porosity > 0.0 && scene.switch_porosity < 1.0) {
+        bail!(
+            "--switch-porosity: must lie in (0, 1), got {}",
+            scene.switch_porosity
         );
     }
     if let Some(f) = rc.iter().find(|f| !(f.is_finite() && **f > 0.0)) {

@@ -57,11 +57,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     };
     let wall = if a.quick { (16, 400.0) } else { (24, 400.0) };
     // The coupling-radius study's jet: the paper's d_ini = 50 µm is 20 across its 1 mm jet.
-    let rc = jet_grain::RcScene {
-        across: if a.quick { 16 } else { 20 },
-        jet_speed_m_s: 500.0,
-        release_ratio: 1.0,
-    };
+    let rc = jet_grain::RcScene::new(if a.quick { 16 } else { 20 }, 500.0, 1.0);
     let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [

@@ -326,11 +326,7 @@ mod tests {
 
     #[test]
     fn every_row_meets_its_tolerance() {
-        let rc = super::super::jet_grain::RcScene {
-            across: 16,
-            jet_speed_m_s: 500.0,
-            release_ratio: 1.0,
-        };
+        let rc = super::super::jet_grain::RcScene::new(16, 500.0, 1.0);
         let rep = run(1.0, 12, 100, (16, 400.0), rc).unwrap();
         assert_eq!(rep.rows.len(), 2 + 4 + 6 + 2 + 3 + 3 + 6);
         for r in &rep.rows {

@@ -102,10 +102,11 @@ fn follow(
     }
 }
 
-/// Releases one unresolved grain (a DEM sphere meeting the water through the coupling) at
-/// `release_speed` m/s into a copy of the settled jet `jet`, with coupling radius `rc_over_d` d,
-/// and follows it to the wall.
-pub fn ride(jet: &World, release_speed: f64, rc_over_d: f64) -> Result<GrainRide, SimError> {
+/// Releases one unresolved grain (a DEM sphere meeting the water through the coupling, AWJ
+/// paper eqs. 42–50) into a copy of the settled jet `jet` of `scene`, with coupling radius
+/// `rc_over_d` d, and follows it to the wall.
+pub fn ride(jet: &World, scene: &RcScene, rc_over_d: f64) -> Result<GrainRide, SimError> {
+    let release_speed = scene.release_speed();
     let mut w = jet.clone();
     let err = |e: crate::error::InputError| fail(format!("jet_grain: {e}"));
     let floor = Wall::new(Vector::zeros(), Vector::new(0.0, 1.0)).map_err(err)?;
@@ -118,6 +119,7 @@ pub fn ride(jet: &World, release_speed: f64, rc_over_d: f64) -> Result<GrainRide
     .map_err(err)?;
     let coupling = CouplingParams {
         radius_factor: rc_over_d,
+        switch_porosity: scene.switch_porosity,
         ..CouplingParams::default()
     };
     w.set_abrasives(Abrasives::new(
@@ -215,8 +217,8 @@ pub const RC_FACTORS: [f64; 5] = [1.0, 1.5, 2.0, 2.5, 3.0];
 const TOL_COINCIDE: f64 = 0.05;
 
 /// The scene of the coupling-radius study: the jet's particles across its width [`JET_B`], its
-/// speed, and the grain's speed at release over the jet's (the paper gives neither speed: its
-/// Table 4 is not in its text).
+/// speed, the grain's speed at release over the jet's (the paper gives neither speed: its
+/// Table 4 is not in its text), and the porosity of the Ergun/Wen–Yu drag switch (eq. 44).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RcScene {
     /// Particles across the jet.
@@ -225,9 +227,21 @@ pub struct RcScene {
     pub jet_speed_m_s: f64,
     /// The grain's speed at release over the jet's.
     pub release_ratio: f64,
+    /// The porosity at and below which the unresolved grain's drag is Ergun's (eq. 44).
+    pub switch_porosity: f64,
 }
 
 impl RcScene {
+    /// A scene with the paper's drag switch (ε = 0.8).
+    pub fn new(across: usize, jet_speed_m_s: f64, release_ratio: f64) -> Self {
+        Self {
+            across,
+            jet_speed_m_s,
+            release_ratio,
+            switch_porosity: CouplingParams::default().switch_porosity,
+        }
+    }
+
     /// The grain's speed at release (m/s).
     pub fn release_speed(&self) -> f64 {
         self.release_ratio * self.jet_speed_m_s
@@ -235,10 +249,14 @@ impl RcScene {
 
     /// The scene as the rows' resolution column.
     fn describe(&self) -> String {
-        format!(
+        let mut s = format!(
             "b/dx={}, v={} m/s, release {}v",
             self.across, self.jet_speed_m_s, self.release_ratio
-        )
+        );
+        if self.switch_porosity != CouplingParams::default().switch_porosity {
+            s += &format!(", switch {}", self.switch_porosity);
+        }
+        s
     }
 }
 
@@ -246,10 +264,7 @@ impl RcScene {
 /// `factors` (in grain diameters).
 pub fn unresolved_rides(scene: RcScene, factors: &[f64]) -> Result<Vec<GrainRide>, SimError> {
     let jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
-    factors
-        .iter()
-        .map(|&f| ride(&jet, scene.release_speed(), f))
-        .collect()
+    factors.iter().map(|&f| ride(&jet, &scene, f)).collect()
 }
 
 /// A fully resolved grain ([`ride_resolved`]) released into the settled jet of `scene`.
