@@ -25,7 +25,8 @@ pub enum StudyError {
     #[error(transparent)]
     Sample(#[from] SampleError),
     /// One point of the speed–accuracy sweep failed.
-    #[error("{variant} at {ppd} per Dg: {source}")]
+    // The cause follows through `source()`: error chains print it once.
+    #[error("{variant} at {ppd} per Dg")]
     Point {
         /// Name of the variant.
         variant: String,
