@@ -129,6 +129,9 @@ fn bad_parameters_are_named() {
     let mut p = tiny();
     p.grain_speed_ratio = 0.0;
     assert!(field(p).contains("grain_speed_ratio"));
+    let mut p = tiny();
+    p.drag_switch_porosity = 1.0;
+    assert!(field(p).contains("drag_switch_porosity"));
     let err = serde_json::from_str::<JetParams>(r#"{"velocity": 400}"#).unwrap_err();
     assert!(err.to_string().contains("velocity"), "{err}");
     let named: JetParams = serde_json::from_str(r#"{"material": "al6061"}"#).unwrap();

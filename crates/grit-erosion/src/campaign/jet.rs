@@ -112,6 +112,8 @@ pub struct JetCampaignSpec {
     pub grain_density_kg_m3: f64,
     /// A grain's speed leaving the nozzle over the jet's.
     pub grain_speed_ratio: f64,
+    /// The porosity of the Ergun/Wen–Yu drag switch (AWJ paper eq. 44).
+    pub drag_switch_porosity: f64,
     /// The grains' contact constants.
     pub dem: DemParams,
     /// The grain–target penalty contact.
@@ -142,6 +144,7 @@ impl Default for JetCampaignSpec {
             grain_diameter_m: p.grain_diameter_m,
             grain_density_kg_m3: p.grain_density_kg_m3,
             grain_speed_ratio: p.grain_speed_ratio,
+            drag_switch_porosity: p.drag_switch_porosity,
             dem: p.dem,
             penalty: p.penalty,
         }
@@ -379,6 +382,7 @@ impl JetCampaignSpec {
                     grain_diameter_m: self.grain_diameter_m,
                     grain_density_kg_m3: self.grain_density_kg_m3,
                     grain_speed_ratio: self.grain_speed_ratio,
+                    drag_switch_porosity: self.drag_switch_porosity,
                     dem: self.dem.clone(),
                     penalty: self.penalty,
                 };

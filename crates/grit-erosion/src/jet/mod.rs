@@ -56,6 +56,9 @@ pub struct JetParams {
     /// grains move with the water; docs/jet.md#one-grain-in-the-jet). The feed keeps the mass
     /// flow M of eq. 55 whatever the ratio.
     pub grain_speed_ratio: f64,
+    /// The porosity at and below which a grain's drag is Ergun's, above it Wen–Yu's (the AWJ
+    /// paper's eq. 44 switch, 0.8 after Gidaspow; in (0, 1); docs/jet.md#one-grain-in-the-jet).
+    pub drag_switch_porosity: f64,
     /// The grains' contact constants (E, ν, restitution e, friction μ).
     pub dem: DemParams,
     /// The grain–target penalty contact (χ, μ).
@@ -79,6 +82,7 @@ impl Default for JetParams {
             grain_diameter_m: 0.2e-3,
             grain_density_kg_m3: 4120.0,
             grain_speed_ratio: 1.0,
+            drag_switch_porosity: grit_sph::coupling::CouplingParams::default().switch_porosity,
             dem: DemParams::default(),
             penalty: PenaltyParams::default(),
         }
@@ -111,6 +115,12 @@ impl JetParams {
             return Err(InputError::new(
                 "grain_speed_ratio",
                 format!("must lie in (0, 1], got {}", self.grain_speed_ratio),
+            ));
+        }
+        if !(self.drag_switch_porosity > 0.0 && self.drag_switch_porosity < 1.0) {
+            return Err(InputError::new(
+                "drag_switch_porosity",
+                format!("must lie in (0, 1), got {}", self.drag_switch_porosity),
             ));
         }
         if !(self.mass_flow_kg_s.is_finite() && self.mass_flow_kg_s >= 0.0) {

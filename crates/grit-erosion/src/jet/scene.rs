@@ -135,6 +135,7 @@ pub fn build(params: &JetParams) -> Result<(World, Layout), InputError> {
         let dem = Dem::new(Vec::new(), Vec::new(), params.dem.clone(), g)?;
         let coupling = CouplingParams {
             radius_factor: params.coupling_radius_d,
+            switch_porosity: params.drag_switch_porosity,
             ..CouplingParams::default()
         };
         world.set_abrasives(Abrasives::new(dem, coupling, params.penalty, Some(water)))?;
