@@ -19,6 +19,21 @@ const TINY: &str = r#"{"spacing_m": 1e-4, "jet_width_m": 6e-4, "target_width_m":
     "target_depth_m": 8e-4, "standoff_m": 6e-4, "grain_diameter_m": 2e-4,
     "mass_flow_kg_s": 0.01, "time_ms": 0.003, "slice_ms": 0.001}"#;
 
+/// Fails the test with the command's stderr unless it exited successfully.
+fn succeeded(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The JSON a successful command printed.
+fn json_of(out: &Output) -> serde_json::Value {
+    succeeded(out);
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 #[test]
 fn a_small_jet_prints_its_series_and_writes_snapshots() {
     let dir = tempfile::tempdir().unwrap();
@@ -37,12 +52,7 @@ fn a_small_jet_prints_its_series_and_writes_snapshots() {
         "--snapshot-every",
         "2",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json_of(&out);
     let series = v["series"].as_array().unwrap();
     assert_eq!(series.len(), 3);
     for key in [
@@ -101,12 +111,7 @@ fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
         "2",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json_of(&out);
     assert_eq!(v["scene"]["jet_speed_m_s"], 300.0);
     let rides = v["rides"].as_array().unwrap();
     assert_eq!(rides.len(), 1);
@@ -152,11 +157,7 @@ fn grit_plot_gathers_jet_run_files_into_a_campaign() {
             "-o",
             file.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        succeeded(&out);
         files.push(file.to_str().unwrap().to_string());
     }
     let charts = dir.path().join("charts");
@@ -164,11 +165,7 @@ fn grit_plot_gathers_jet_run_files_into_a_campaign() {
     args.extend(files.iter().map(String::as_str));
     let out = grit(&args);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeded(&out);
     // One cell (equal parameters) of two samples, the seeds.
     let row = stdout.lines().nth(1).unwrap_or_default();
     assert!(row.contains("500 m/s") && row.contains(" 2 "), "{stdout}");
