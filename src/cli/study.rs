@@ -26,7 +26,8 @@ enum Study {
         after_help = "Example: grit study rc --across 32 --jet-speed-m-s 500 --release-ratio 1 --resolved"
     )]
     Rc {
-        /// Water particles across the 1 mm jet (even; the resolved grain wants 24 or more).
+        /// Water particles across the 1 mm jet (even; at 500 m/s a resolved grain ran at 32 to 44
+        /// across, and failed at 24 and at 48 or more: docs/jet.md#one-grain-in-the-jet).
         #[arg(long, default_value_t = 16)]
         across: usize,
         /// The jet's speed (m/s).
