@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use grit_erosion::studies::settle::{settle_study, SettleRow};
+use grit_sph::coupling::DEFAULT_SWITCH_POROSITY;
 use grit_sph::verification::jet_grain::{self, GrainRide, RcScene};
 
 use super::output::say;
@@ -38,7 +39,7 @@ enum Study {
         release_ratio: f64,
         /// The porosity at and below which the unresolved drag is Ergun's, above it Wen–Yu's
         /// (the paper's 0.8; eq. 44).
-        #[arg(long, default_value_t = 0.8)]
+        #[arg(long, default_value_t = DEFAULT_SWITCH_POROSITY)]
         switch_porosity: f64,
         /// Coupling radii R_c/d of the unresolved grains, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "1,1.5,2,2.5,3")]
@@ -106,16 +107,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                     "settling the jet and riding {} grain(s) ...",
                     rc.len() + usize::from(resolved)
                 );
-                let jet = jet_grain::settled_jet(across, jet_speed_m_s)?;
-                let v = scene.release_speed();
-                let mut rides = rc
-                    .iter()
-                    .map(|&f| jet_grain::ride(&jet, &scene, f))
-                    .collect::<Result<Vec<_>, _>>()?;
-                if resolved {
-                    rides.push(jet_grain::ride_resolved(&jet, v)?);
-                }
-                Ok(rides)
+                Ok(jet_grain::rides(&scene, &rc, resolved)?)
             })?;
             if let Some(path) = &chart {
                 super::plot::line_chart(&jet_grain::rides_chart(&scene, &rides), path)?;

@@ -82,7 +82,7 @@ impl Default for JetParams {
             grain_diameter_m: 0.2e-3,
             grain_density_kg_m3: 4120.0,
             grain_speed_ratio: 1.0,
-            drag_switch_porosity: grit_sph::coupling::CouplingParams::default().switch_porosity,
+            drag_switch_porosity: grit_sph::coupling::DEFAULT_SWITCH_POROSITY,
             dem: DemParams::default(),
             penalty: PenaltyParams::default(),
         }

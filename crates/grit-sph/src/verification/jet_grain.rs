@@ -10,7 +10,7 @@
 
 use super::jet_wall::{jet_wall_world, JET_B};
 use super::{fail, CaseReport, Chart, Row, Series};
-use crate::coupling::CouplingParams;
+use crate::coupling::{CouplingParams, DEFAULT_SWITCH_POROSITY};
 use crate::dem::{Dem, DemParams, Grain, Wall};
 use crate::error::SimError;
 use crate::fluid::Fluid;
@@ -238,7 +238,7 @@ impl RcScene {
             across,
             jet_speed_m_s,
             release_ratio,
-            switch_porosity: CouplingParams::default().switch_porosity,
+            switch_porosity: DEFAULT_SWITCH_POROSITY,
         }
     }
 
@@ -253,24 +253,26 @@ impl RcScene {
             "b/dx={}, v={} m/s, release {}v",
             self.across, self.jet_speed_m_s, self.release_ratio
         );
-        if self.switch_porosity != CouplingParams::default().switch_porosity {
+        if self.switch_porosity != DEFAULT_SWITCH_POROSITY {
             s += &format!(", switch {}", self.switch_porosity);
         }
         s
     }
 }
 
-/// Unresolved grains released into one settled jet of `scene`, one per coupling radius of
-/// `factors` (in grain diameters).
-pub fn unresolved_rides(scene: RcScene, factors: &[f64]) -> Result<Vec<GrainRide>, SimError> {
+/// Grains released into one settled jet of `scene`: an unresolved grain per coupling radius
+/// of `factors` (in grain diameters), then, if `resolved`, a fully resolved one
+/// ([`ride_resolved`]).
+pub fn rides(scene: &RcScene, factors: &[f64], resolved: bool) -> Result<Vec<GrainRide>, SimError> {
     let jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
-    factors.iter().map(|&f| ride(&jet, &scene, f)).collect()
-}
-
-/// A fully resolved grain ([`ride_resolved`]) released into the settled jet of `scene`.
-pub fn resolved_ride(scene: RcScene) -> Result<GrainRide, SimError> {
-    let jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
-    ride_resolved(&jet, scene.release_speed())
+    let mut rides = factors
+        .iter()
+        .map(|&f| ride(&jet, scene, f))
+        .collect::<Result<Vec<_>, _>>()?;
+    if resolved {
+        rides.push(ride_resolved(&jet, scene.release_speed())?);
+    }
+    Ok(rides)
 }
 
 /// The study's rows on `scene`: the contact speed at each R_c of [`RC_FACTORS`] (2.0 d judged
@@ -278,7 +280,7 @@ pub fn resolved_ride(scene: RcScene) -> Result<GrainRide, SimError> {
 /// docs/jet.md#one-grain-in-the-jet), whether 2.5 d and 3.0 d coincide, and the chart of the
 /// grains' speeds.
 pub fn rc_study(scene: RcScene) -> Result<CaseReport, SimError> {
-    let rides = unresolved_rides(scene, &RC_FACTORS)?;
+    let rides = rides(&scene, &RC_FACTORS, false)?;
     let mut rep = CaseReport::default();
     let mut contact = Vec::new();
     for (f, ride) in RC_FACTORS.into_iter().zip(&rides) {
