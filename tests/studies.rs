@@ -192,28 +192,6 @@ fn studies_refuse_bad_input_naming_the_option() {
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
-    // A 4-layer sponge in a 1.0 Dg surface is 12 layers at 8 per Dg, too few: the point is
-    // named, and its cause said once.
-    let o = grit(&[
-        "bench",
-        "sweep",
-        "--ppd",
-        "8",
-        "--variants",
-        "default_absorbing=4",
-        "--depth-dg",
-        "1.0",
-        "--impacts",
-        "21",
-        "--samples",
-        "2",
-        "--out",
-        out,
-    ]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("at 8 per Dg"), "{stderr}");
-    assert_eq!(stderr.matches("surface_depth_dg").count(), 1, "{stderr}");
 }
 
 /// The figures and JSON names the impact bench promises, from a coarse impact timed twice each way; the

@@ -124,7 +124,6 @@ pub struct SweepArgs {
     /// wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X (CFL X with the density filter's
     /// seed period in simulated time), filter=N (the density filter every N steps, 0 = off),
     /// default_filter=N (the default numerics with the filter every N steps, 0 = off),
-    /// absorbing=N, default_absorbing=N (the default numerics with an absorbing layer of N Δx),
     /// h=X (the default numerics with h/Δx = X, in [1, 2]); the first is the reference.
     #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
     variants: Vec<String>,

@@ -3,9 +3,9 @@
 //! surface has settled.
 
 use grit_sph::{
-    cfl_matched_stiffness, contact::ContactModel, neighbours, particles::KINEMATIC, Absorber,
-    ContactParams, InputError, KernelKind, Material, Motion, Particles, Polygon, Settings,
-    SimError, Timers, Vector, World,
+    cfl_matched_stiffness, contact::ContactModel, neighbours, particles::KINEMATIC, ContactParams,
+    InputError, KernelKind, Material, Motion, Particles, Polygon, Settings, SimError, Timers,
+    Vector, World,
 };
 use serde::{Deserialize, Serialize};
 
@@ -51,10 +51,11 @@ pub struct ImpactParams {
 /// In JSON it keeps one flat object of the choices a scene may set (`NumericsJson`): the
 /// engine's `kernel`, `cfl`, `hourglass`, `contact_limits_dt`, and `grain_shell` for its
 /// `rigid_shell`, beside the impact's own. The engine's other settings are not part of a scene,
-/// so stored scenes and checkpoints read and write the same bytes as ever; the retired
-/// `cell_order` key is still written (as `false`) and read (either value, ignored).
+/// so stored scenes and checkpoints read and write the same bytes as ever; the retired keys
+/// are still written, `cell_order` as `false` (read with either value, ignored) and
+/// `absorbing_layers` as `0.0` (read only as 0).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(from = "NumericsJson", into = "NumericsJson")]
+#[serde(try_from = "NumericsJson", into = "NumericsJson")]
 pub struct Numerics {
     /// Engine settings: kernel (seed: quintic spline, eq. 4), Courant number, hourglass α of
     /// eq. 16, whether the contact springs may shorten the time step (off only in the stability
@@ -68,9 +69,6 @@ pub struct Numerics {
     /// Move the grain along its straight, force-free path to just before its first contact
     /// instead of simulating the flight step by step (docs/performance.md, "model no more").
     pub skip_flight: bool,
-    /// Thickness, in particle layers, of an absorbing (sponge) layer just inside the surface's
-    /// fixed bottom and side bands; 0 for none (`grit_sph::Absorber`).
-    pub absorbing_layers: f64,
 }
 
 /// Courant number of the default scene: twice the seed's, with the density filter kept at the
@@ -99,7 +97,6 @@ impl Numerics {
             contact_model: ContactModel::Extrapolated,
             contact_stiffness_scale: 1.0,
             skip_flight: true,
-            absorbing_layers: 0.0,
         }
     }
 
@@ -136,6 +133,9 @@ struct NumericsJson {
     // it changed results by rounding only, so a scene stored with `true` reads as one without
     // it. Written as `false` so that stored scenes keep their bytes.
     cell_order: bool,
+    // The absorbing layer along the surface's fixed bands, deleted (docs/performance.md, "An
+    // absorbing layer"): written as 0 so that stored scenes keep their bytes; a scene that
+    // asks for a layer is refused rather than run without it.
     absorbing_layers: f64,
     // Absent, the filter keeps the seed's period in time at this scene's `cfl`; written only
     // where it differs from that, so scenes at CFL 0.3 stored before this key existed keep
@@ -162,16 +162,25 @@ impl From<Numerics> for NumericsJson {
             grain_shell: n.engine.rigid_shell,
             skip_flight: n.skip_flight,
             cell_order: false,
-            absorbing_layers: n.absorbing_layers,
+            absorbing_layers: 0.0,
             shepard_interval: (n.engine.shepard_interval != filter_interval_in_time(n.engine.cfl))
                 .then_some(n.engine.shepard_interval),
         }
     }
 }
 
-impl From<NumericsJson> for Numerics {
-    fn from(j: NumericsJson) -> Self {
-        Numerics {
+impl TryFrom<NumericsJson> for Numerics {
+    type Error = String;
+
+    fn try_from(j: NumericsJson) -> Result<Self, String> {
+        if j.absorbing_layers != 0.0 {
+            return Err(format!(
+                "absorbing_layers: the absorbing layer was measured and not adopted \
+                 (docs/performance.md); only 0 is read, got {}",
+                j.absorbing_layers
+            ));
+        }
+        Ok(Numerics {
             engine: Settings {
                 kernel: j.kernel,
                 cfl: j.cfl,
@@ -186,8 +195,7 @@ impl From<NumericsJson> for Numerics {
             contact_model: j.contact_model,
             contact_stiffness_scale: j.contact_stiffness_scale,
             skip_flight: j.skip_flight,
-            absorbing_layers: j.absorbing_layers,
-        }
+        })
     }
 }
 
@@ -215,8 +223,6 @@ impl Default for ImpactParams {
 /// support (3h = 3.9 Δx), so free particles never see a truncated kernel there.
 const FIXED_LAYERS: f64 = 4.0;
 
-/// Continuum reflection of a normally incident wave the absorbing layer is tuned for.
-const ABSORBER_REFLECTION: f64 = 0.01;
 /// Fewest particle layers a surface may have: fixed layers below, free layers between, and as
 /// many again for the impact to work in.
 pub const MIN_SURFACE_LAYERS: f64 = 3.0 * FIXED_LAYERS;
@@ -290,22 +296,12 @@ impl ImpactParams {
                 ),
             ));
         }
-        let a = self.numerics.absorbing_layers;
-        if !(a.is_finite() && a >= 0.0) {
-            return Err(InputError::new(
-                "numerics.absorbing_layers",
-                format!("must be >= 0, got {a}"),
-            ));
-        }
         let layers = self.surface_depth_dg * self.grain_diameter_m / self.spacing_m;
-        if layers < MIN_SURFACE_LAYERS + a {
+        if layers < MIN_SURFACE_LAYERS {
             return Err(InputError::new(
                 "surface_depth_dg",
                 format!(
-                    "gives {layers:.1} particle layers; at least {} are needed, {} of them for \
-                     numerics.absorbing_layers",
-                    MIN_SURFACE_LAYERS + a,
-                    a
+                    "gives {layers:.1} particle layers; at least {MIN_SURFACE_LAYERS} are needed"
                 ),
             ));
         }
@@ -349,29 +345,6 @@ impl ImpactParams {
         let nx = (self.surface_width_dg * self.grain_diameter_m / dx).round();
         let ny = (self.surface_depth_dg * self.grain_diameter_m / dx).round();
         (0.5 * nx * dx, ny * dx)
-    }
-
-    /// The absorbing layer of `numerics.absorbing_layers`, just inside the fixed bands, tuned
-    /// to reflect 1 % of a normally incident wave in the continuum; None when 0.
-    pub fn absorber(&self) -> Option<Absorber> {
-        let layers = self.numerics.absorbing_layers;
-        if layers <= 0.0 {
-            return None;
-        }
-        let (hw, depth) = self.surface_extent();
-        let inset = (FIXED_LAYERS + layers) * self.spacing_m;
-        let thickness_m = layers * self.spacing_m;
-        Some(Absorber {
-            inner_lo: Vector::new(-hw + inset, -depth + inset),
-            // The top is free: the box reaches far above it.
-            inner_hi: Vector::new(hw - inset, depth),
-            thickness_m,
-            sigma_max_per_s: Absorber::sigma_for(
-                self.material.sound_speed(),
-                thickness_m,
-                ABSORBER_REFLECTION,
-            ),
-        })
     }
 
     /// The fresh surface: a lattice rectangle, top at y = 0, centred on x = 0, its bottom and
@@ -540,9 +513,6 @@ pub fn impact_world(
     state.vel.iter_mut().for_each(|v| *v = Vector::zeros());
     let s = world.add_deformable_state("surface", params.material.clone(), state, Motion::Fixed)?;
     world.reset_temperature();
-    if let Some(a) = params.absorber() {
-        world.set_absorber(s, a)?;
-    }
     let g = world.add_rigid(
         "grain",
         &grain.polygon,
@@ -920,6 +890,15 @@ mod tests {
         assert!(serde_json::to_string(&n)
             .unwrap()
             .contains(r#""cell_order":false"#));
+    }
+
+    #[test]
+    fn a_scene_asking_for_the_retired_absorbing_layer_is_refused() {
+        let n: Numerics = serde_json::from_str(r#"{"absorbing_layers": 0.0}"#).unwrap();
+        assert_eq!(n, Numerics::default());
+        let e = serde_json::from_str::<Numerics>(r#"{"absorbing_layers": 4.0}"#).unwrap_err();
+        assert!(e.to_string().contains("absorbing_layers"), "{e}");
+        assert!(e.to_string().contains("not adopted"), "{e}");
     }
 
     #[test]

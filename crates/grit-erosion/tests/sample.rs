@@ -149,22 +149,9 @@ fn bad_scene_names_the_field() {
             "friction",
         ),
         (
+            // 0.3 Dg at 8 µm is 9.4 layers, fewer than the 12 a surface needs.
             ImpactParams {
-                numerics: grit_erosion::Numerics {
-                    absorbing_layers: -1.0,
-                    ..Default::default()
-                },
-                ..Default::default()
-            },
-            "numerics.absorbing_layers",
-        ),
-        (
-            // 1.5 Dg at 8 µm is 46.9 layers: 12 for the scene, so 35 absorbing ones are too many.
-            ImpactParams {
-                numerics: grit_erosion::Numerics {
-                    absorbing_layers: 35.0,
-                    ..Default::default()
-                },
+                surface_depth_dg: 0.3,
                 ..Default::default()
             },
             "surface_depth_dg",

@@ -24,44 +24,6 @@ pub enum Motion {
     },
 }
 
-/// A viscous layer along a deformable body's fixed edges that stands in for the rest of the
-/// body: waves running out of the body are damped in it instead of reflected back (a sponge
-/// layer; docs/design.md#model-no-more-than-a-scene-needs). The damping rate grows as σ_max (d/L)² with the distance
-/// d of a particle outside the undamped inner box, up to d = L.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Absorber {
-    /// Lower-left corner of the undamped box (m).
-    pub inner_lo: Vector,
-    /// Upper-right corner of the undamped box (m).
-    pub inner_hi: Vector,
-    /// Layer thickness L (m).
-    pub thickness_m: f64,
-    /// Damping rate at depth L into the layer, σ_max (1/s).
-    pub sigma_max_per_s: f64,
-}
-
-impl Absorber {
-    /// Damping rate σ (1/s) at `x`.
-    #[inline]
-    pub fn sigma(&self, x: Vector) -> f64 {
-        let d = (self.inner_lo.x - x.x)
-            .max(x.x - self.inner_hi.x)
-            .max(self.inner_lo.y - x.y)
-            .max(x.y - self.inner_hi.y);
-        if d <= 0.0 {
-            return 0.0;
-        }
-        let f = (d / self.thickness_m).min(1.0);
-        self.sigma_max_per_s * f * f
-    }
-
-    /// σ_max of a quadratic layer of thickness `thickness_m` whose normal-incidence reflection
-    /// of a wave of speed `c_m_s` is `reflection` in the continuum: σ_max = 3c ln(1/R) / (2L).
-    pub fn sigma_for(c_m_s: f64, thickness_m: f64, reflection: f64) -> f64 {
-        1.5 * c_m_s * (1.0 / reflection).ln() / thickness_m
-    }
-}
-
 impl Motion {
     /// The prescribed velocity at time `t`, or `None` for free motion.
     pub fn velocity(&self, t: f64) -> Option<Vector> {
@@ -146,9 +108,6 @@ pub enum BodyKind {
         material: Material,
         /// Motion of its kinematic particles (a prescribed-motion boundary), if any.
         boundary_motion: Motion,
-        /// Absorbing layer along its edges, if any.
-        #[serde(default)]
-        absorber: Option<Absorber>,
     },
     /// A rigid body.
     Rigid(Rigid),

@@ -29,7 +29,7 @@ pub mod timers;
 pub mod vtk;
 pub mod world;
 
-pub use body::{Absorber, Body, BodyKind, ExternalForce, Motion, Rigid};
+pub use body::{Body, BodyKind, ExternalForce, Motion, Rigid};
 pub use contact::{cfl_matched_stiffness, ContactModel, ContactParams};
 pub use geometry::Polygon;
 pub use kernel::{Kernel, KernelKind};

@@ -151,7 +151,7 @@ fn bad_fluid_input_names_its_field() {
     let mut fed = World::new(w.settings().clone()).unwrap();
     let empty = fed.add_fluid("w", water(), &[], &[], &[], Vector::zeros());
     assert_eq!(empty.unwrap(), 0);
-    // A fluid body takes kinematic walls, not an absorbing layer.
+    // A fluid body takes kinematic walls.
     let b = w
         .add_fluid("w", water(), &pts, &[1e-10; 2], &[0.0; 2], Vector::zeros())
         .unwrap();

@@ -45,3 +45,21 @@ pub fn scene(angle_deg: f64, spacing_m: f64) -> ImpactParams {
         ..ImpactParams::paper(angle_deg, Shape::Hexagon)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error;
+
+    #[test]
+    fn a_failed_point_names_itself_and_leaves_its_cause_to_the_chain() {
+        let cause = SampleError::Checkpoint("torn".into());
+        let e = StudyError::Point {
+            variant: "default".into(),
+            ppd: 8.0,
+            source: cause,
+        };
+        assert_eq!(e.to_string(), "default at 8 per Dg");
+        assert_eq!(e.source().unwrap().to_string(), "checkpoint: torn");
+    }
+}

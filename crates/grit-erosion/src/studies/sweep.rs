@@ -34,11 +34,6 @@ pub enum Variant {
     /// The paper's numerics with the grain's approach flight simulated step by step, as before
     /// the flight skip (`Numerics::skip_flight`) became the default.
     FullFlight,
-    /// The paper's numerics with an absorbing layer of this many particle layers inside the
-    /// surface's fixed bands (`Numerics::absorbing_layers`).
-    Absorbing(f64),
-    /// The default scene's numerics with an absorbing layer of this many particle layers.
-    DefaultAbsorbing(f64),
     /// The paper's numerics with the density filter (eq. 12) every this many steps instead of
     /// 40; 0 switches it off.
     Filter(u32),
@@ -55,18 +50,11 @@ pub enum Variant {
 
 impl Variant {
     /// Parses `seed`, `default`, `wendland_c2`, `cubic_spline`, `full_flight`, `cfl=X`,
-    /// `cfl_time=X`, `filter=N`, `default_filter=N`, `absorbing=N`, `default_absorbing=N` or
-    /// `h=X`.
+    /// `cfl_time=X`, `filter=N`, `default_filter=N` or `h=X`.
     pub fn parse(s: &str) -> Result<Variant, InputError> {
         fn bad<T>(rule: String) -> Result<T, InputError> {
             Err(InputError::new("--variants", rule))
         }
-        let layers = |other: &str, tail: &str| match tail.parse::<f64>() {
-            Ok(n) if n.is_finite() && n > 0.0 => Ok(n),
-            _ => bad(format!(
-                "`{other}`: the absorbing layer needs a number of layers > 0"
-            )),
-        };
         match s.trim() {
             "seed" | "quintic" => Ok(Variant::Seed),
             "default" => Ok(Variant::Default),
@@ -103,19 +91,13 @@ impl Variant {
                 Ok(h) if (1.0..=2.0).contains(&h) => Ok(Variant::HOverDx(h)),
                 _ => bad(format!("`{other}`: h/Δx must be in [1, 2]")),
             },
-            other if other.starts_with("absorbing=") => {
-                layers(other, &other["absorbing=".len()..]).map(Variant::Absorbing)
-            }
-            other if other.starts_with("default_absorbing=") => {
-                layers(other, &other["default_absorbing=".len()..]).map(Variant::DefaultAbsorbing)
-            }
             other => match other.strip_prefix("cfl=").map(str::parse::<f64>) {
                 Some(Ok(c)) if c > 0.0 && c <= grit_sph::world::MAX_CFL => Ok(Variant::Cfl(c)),
                 Some(_) => bad(format!(
                     "`{other}`: the Courant number must be in (0, 2]"
                 )),
                 None => bad(format!(
-                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, default_filter=N, absorbing=N, default_absorbing=N, h=X)"
+                    "unknown variant `{other}` (known: seed, default, wendland_c2, cubic_spline, full_flight, cfl=X, cfl_time=X, filter=N, default_filter=N, h=X)"
                 )),
             },
         }
@@ -134,8 +116,6 @@ impl Variant {
             Variant::CubicSpline => "cubic spline".into(),
             Variant::Cfl(c) => format!("CFL {c}"),
             Variant::FullFlight => "seed, flight simulated".into(),
-            Variant::Absorbing(n) => format!("seed, absorbing layer of {n} Δx"),
-            Variant::DefaultAbsorbing(n) => format!("default, absorbing layer of {n} Δx"),
             Variant::Filter(0) => "seed, no density filter".into(),
             Variant::Filter(n) => format!("seed, density filter every {n} steps"),
             Variant::CflFilterInTime(c) => format!(
@@ -158,11 +138,6 @@ impl Variant {
             Variant::CubicSpline => n.engine.kernel = KernelKind::CubicSpline,
             Variant::Cfl(cfl) => n.engine.cfl = cfl,
             Variant::FullFlight => n.skip_flight = false,
-            Variant::Absorbing(layers) => n.absorbing_layers = layers,
-            Variant::DefaultAbsorbing(layers) => {
-                n = Numerics::default();
-                n.absorbing_layers = layers;
-            }
             Variant::Filter(every) => n.engine.shepard_interval = every,
             Variant::CflFilterInTime(cfl) => n = n.with_cfl_filter_in_time(cfl),
             Variant::DefaultFilter(every) => {
@@ -603,14 +578,6 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("(0, 2]"));
-        assert_eq!(Variant::parse("absorbing=4"), Ok(Variant::Absorbing(4.0)));
-        let sponge = Variant::parse("default_absorbing=4").unwrap().numerics();
-        assert_eq!(sponge.absorbing_layers, 4.0);
-        assert_eq!(sponge.engine.cfl, Numerics::default().engine.cfl);
-        assert!(Variant::parse("default_absorbing=0")
-            .unwrap_err()
-            .to_string()
-            .contains("layers > 0"));
         assert_eq!(Variant::parse("filter=0"), Ok(Variant::Filter(0)));
         assert_eq!(Variant::parse("h=1.1"), Ok(Variant::HOverDx(1.1)));
         let off = Variant::parse("default_filter=0").unwrap().numerics();
@@ -630,10 +597,10 @@ mod tests {
         assert_eq!(filter_interval_in_time(0.6), 20);
         assert_eq!(filter_interval_in_time(0.45), 27);
         assert_eq!(filter_interval_in_time(0.3), 40);
-        assert!(Variant::parse("absorbing=-1")
+        assert!(Variant::parse("absorbing=4")
             .unwrap_err()
             .to_string()
-            .contains("number of layers > 0"));
+            .contains("unknown variant `absorbing=4`"));
         assert!(Variant::parse("cubic")
             .unwrap_err()
             .to_string()

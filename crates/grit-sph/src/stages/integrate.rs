@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use super::{BodyConst, ParTasks};
-use crate::body::{Absorber, Body, BodyKind};
+use crate::body::{Body, BodyKind};
 use crate::math::Vector;
 use crate::particles::{Particles, KINEMATIC};
 
@@ -17,18 +17,9 @@ pub(crate) enum Blowup {
     Rigid { body: usize },
 }
 
-/// One particle's outcome of the integration.
-struct Update {
-    /// The check it failed, if any.
-    failure: Option<String>,
-    /// Work of its absorbing layer over the step (J/m).
-    absorbed: f64,
-}
-
 /// Integrates deformable and fluid particles from `time` by `dt` (semi-implicit Euler) with the
-/// SPH accelerations `acc` and the contact forces `contact_force`, damped in absorbing layers;
-/// adds the layers' work to `absorbed`, in particle order. Then the failure checks: finite state,
-/// positive density, no particle moved more than `h`, finite rigid bodies.
+/// SPH accelerations `acc` and the contact forces `contact_force`. Then the failure checks:
+/// finite state, positive density, no particle moved more than `h`, finite rigid bodies.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate(
     p: &mut Particles,
@@ -39,7 +30,6 @@ pub(crate) fn integrate(
     contact_force: &[Vector],
     time: f64,
     dt: f64,
-    absorbed: &mut f64,
 ) -> Option<Blowup> {
     let t_next = time + dt;
     let motions: Vec<Option<Vector>> = bodies
@@ -54,15 +44,8 @@ pub(crate) fn integrate(
             _ => None,
         })
         .collect();
-    let absorbers: Vec<Option<Absorber>> = bodies
-        .iter()
-        .map(|b| match &b.kind {
-            BodyKind::Deformable { absorber, .. } => *absorber,
-            _ => None,
-        })
-        .collect();
     let cf = contact_force;
-    let out: Vec<Update> = p
+    let out: Vec<Option<String>> = p
         .pos
         .par_iter_mut()
         .zip(p.vel.par_iter_mut())
@@ -71,60 +54,40 @@ pub(crate) fn integrate(
         .map(|(i, (x, v))| {
             let b = p.body[i] as usize;
             if !bc[b].integrated() {
-                return Update {
-                    failure: None,
-                    absorbed: 0.0,
-                };
+                return None;
             }
-            let mut absorbed = 0.0;
             if p.flags[i] & KINEMATIC != 0 {
                 *v = motions[b].unwrap_or_else(Vector::zeros);
             } else {
-                let free = *v + (acc[i] + cf[i] / p.mass[i]) * dt;
-                // Implicit in the damping, so any σ dt is stable.
-                let sigma = absorbers[b].map_or(0.0, |a| a.sigma(*x));
-                *v = free / (1.0 + sigma * dt);
-                // The work of the damping force −mσv over the step's displacement v dt.
-                absorbed = -p.mass[i] * sigma * v.norm_squared() * dt;
+                *v += (acc[i] + cf[i] / p.mass[i]) * dt;
             }
             let dxs = *v * dt;
             *x += dxs;
-            let failed = |what: String| Update {
-                failure: Some(what),
-                absorbed,
-            };
             if !(x.x.is_finite() && x.y.is_finite() && v.x.is_finite() && v.y.is_finite()) {
-                return failed("position or velocity is not finite".to_string());
+                return Some("position or velocity is not finite".to_string());
             }
             if !(p.sdev[i].iter().all(|s| s.is_finite()) && p.rho[i].is_finite()) {
-                return failed("stress or density is not finite".to_string());
+                return Some("stress or density is not finite".to_string());
             }
             if p.rho[i] <= 0.0 {
-                return failed(format!("density {:.4e} kg/m³ is not positive", p.rho[i]));
+                return Some(format!("density {:.4e} kg/m³ is not positive", p.rho[i]));
             }
             let step = dxs.norm();
             if step > h {
-                return failed(format!(
+                return Some(format!(
                     "moved {step:.3e} m in one step, more than h = {h:.3e} m"
                 ));
             }
-            Update {
-                failure: None,
-                absorbed,
-            }
+            None
         })
         .collect();
-    // Serial, in particle order: the first failure and the absorbed work do not depend on
-    // the thread count.
-    let mut bad = None;
-    for (i, u) in out.into_iter().enumerate() {
-        *absorbed += u.absorbed;
-        if bad.is_none() {
-            bad = u.failure.map(|what| Blowup::Particle { index: i, what });
-        }
-    }
-    if bad.is_some() {
-        return bad;
+    // The first failure in particle order, whatever the thread count.
+    if let Some((index, what)) = out
+        .into_iter()
+        .enumerate()
+        .find_map(|(i, f)| f.map(|what| (i, what)))
+    {
+        return Some(Blowup::Particle { index, what });
     }
     bodies
         .iter()

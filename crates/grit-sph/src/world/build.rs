@@ -1,7 +1,7 @@
 //! Building a world: adding bodies, particles and contact pairs, and removing them again.
 
 use super::World;
-use crate::body::{Absorber, Body, BodyKind, ExternalForce, Motion, Rigid};
+use crate::body::{Body, BodyKind, ExternalForce, Motion, Rigid};
 use crate::contact::{self, ContactPair, ContactParams};
 use crate::error::InputError;
 use crate::fluid::Fluid;
@@ -87,7 +87,6 @@ impl World {
             kind: BodyKind::Deformable {
                 material,
                 boundary_motion: Motion::Fixed,
-                absorber: None,
             },
             removed_mass_kg_m: 0.0,
             removed_particles: 0,
@@ -253,7 +252,6 @@ impl World {
             kind: BodyKind::Deformable {
                 material,
                 boundary_motion,
-                absorber: None,
             },
             removed_mass_kg_m: 0.0,
             removed_particles: 0,
@@ -313,40 +311,6 @@ impl World {
             }
         }
         Ok(n)
-    }
-
-    /// Gives deformable body `b` an absorbing layer (a sponge along its edges, `Absorber`).
-    pub fn set_absorber(&mut self, b: usize, layer: Absorber) -> Result<(), InputError> {
-        InputError::require_positive("absorber.thickness_m", layer.thickness_m)?;
-        if !(layer.sigma_max_per_s.is_finite() && layer.sigma_max_per_s >= 0.0) {
-            return Err(InputError::new(
-                "absorber.sigma_max_per_s",
-                format!(
-                    "must be a finite number >= 0, got {}",
-                    layer.sigma_max_per_s
-                ),
-            ));
-        }
-        let corners = [layer.inner_lo, layer.inner_hi];
-        if !corners.iter().all(|c| c.x.is_finite() && c.y.is_finite())
-            || layer.inner_lo.x > layer.inner_hi.x
-            || layer.inner_lo.y > layer.inner_hi.y
-        {
-            return Err(InputError::new(
-                "absorber.inner_lo",
-                "the undamped box needs finite corners with inner_lo below and left of inner_hi",
-            ));
-        }
-        match self.bodies.get_mut(b).map(|body| &mut body.kind) {
-            Some(BodyKind::Deformable { absorber, .. }) => {
-                *absorber = Some(layer);
-                Ok(())
-            }
-            _ => Err(InputError::new(
-                "absorber",
-                "only deformable bodies take an absorbing layer",
-            )),
-        }
     }
 
     /// Adds a rigid polygon of `density_kg_m3` (mass and inertia from the polygon itself),

@@ -39,9 +39,6 @@ pub struct NumericalWork {
     pub contact_damping: f64,
     /// Plastic work (heat and stored work of plasticity).
     pub plastic: f64,
-    /// Work of the absorbing layers (`Absorber`).
-    #[serde(default)]
-    pub absorbed: f64,
 }
 
 impl World {

@@ -615,7 +615,6 @@ impl World {
             &self.scratch.contact_force,
             self.time,
             dt,
-            &mut self.work.absorbed,
         );
         let what = match blowup {
             None => return Ok(()),
