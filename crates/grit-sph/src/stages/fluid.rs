@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{HalfPair, PairCache};
+use super::pairs::{HalfPair, PairCache, APART, USED};
 use super::{BodyConst, ParTasks, SphView};
 use crate::eos::MieGruneisen;
 use crate::fluid::{self, ArtificialViscosity, Fluid};
@@ -96,8 +96,9 @@ fn pairs_of<'a>(
     let nl = s.nl;
     let ids = &hi.id[nl.start[i] as usize..];
     nl.of(i).iter().zip(ids).filter_map(move |(&j, &id)| {
-        let pair = cache.half[id as usize];
-        (pair.used && pair.r > 0.0).then(|| (j as usize, pair.seen((j as usize) < i)))
+        let bits = cache.flags[id as usize];
+        (bits & (USED | APART) == USED | APART)
+            .then(|| (j as usize, cache.half[id as usize].seen((j as usize) < i)))
     })
 }
 

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{rows_mut, HalfPair, PairCache, Side};
+use super::pairs::{rows_mut, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
 use super::{ParTasks, SphView, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{Matrix, Vector};
 use crate::neighbours::HalfIndex;
@@ -89,25 +89,19 @@ pub(crate) fn forces(
         .enumerate()
         .for_each(|(i, row)| {
             let js = hi.upper_of(nl, i);
-            let pairs = &cache.half[hi.start[i] as usize..];
+            let at = hi.start[i] as usize;
+            let pairs = cache.half[at..].iter().zip(&cache.flags[at..]);
             let c = bc[p.body[i] as usize];
-            for ((out, &j), pair) in row.iter_mut().zip(js).zip(pairs) {
+            for ((out, &j), (pair, &bits)) in row.iter_mut().zip(js).zip(pairs) {
                 let j = j as usize;
-                if !pair.used || !(active[i] || active[j]) {
+                if bits & USED == 0 || !(active[i] || active[j]) {
                     continue;
                 }
-                if pair.r == 0.0 {
+                if bits & APART == 0 {
                     *out = PairForce::default();
                     continue;
                 }
-                let HalfPair {
-                    xij,
-                    e,
-                    r,
-                    dw_r,
-                    near_ref,
-                    ..
-                } = *pair;
+                let HalfPair { xij, dw_r, .. } = *pair;
                 let mut stress = (sig[i] + sig[j]) * (xij * dw_r);
                 if let Some(av) = &av {
                     let (vij, rho_mean) = (p.vel[i] - p.vel[j], 0.5 * (p.rho[i] + p.rho[j]));
@@ -115,12 +109,14 @@ pub(crate) fn forces(
                 }
                 let mut hourglass = Vector::zeros();
                 if hourglass_on(pair) {
+                    let r = pair.r();
+                    let e = xij / r;
                     // Viscous part: velocity error against the mean velocity gradient.
                     let vij = p.vel[i] - p.vel[j];
                     let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
                     let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
                     // Stiffness part: separation error against the mean deformation gradient.
-                    let stiff = if near_ref {
+                    let stiff = if bits & NEAR_REF != 0 {
                         let xr = p.x_ref[i] - p.x_ref[j];
                         let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
                         c.youngs * ds.clamp(-0.5 * r, 0.5 * r)

@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{fill_half_pairs, rows_mut, PairCache, Side};
+use super::pairs::{fill_half_pairs, rows_mut, PairCache, Side, APART, USED};
 use super::{ParTasks, SphView, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{outer, Matrix};
 use crate::neighbours::HalfIndex;
@@ -49,8 +49,8 @@ pub(crate) fn kernel_sums(
     let w0 = k.w(0.0);
     super::volumes(p, &mut sums.vol);
     let vol = &sums.vol;
-    fill_half_pairs(p, nl, hi, k, &mut cache.half);
-    let half = &cache.half;
+    fill_half_pairs(p, nl, hi, k, &mut cache.half, &mut cache.flags);
+    let (half, flags) = (&cache.half, &cache.flags);
     let out: Vec<ParticleSums> = rows_mut(&mut cache.sides, &nl.start)
         .into_par_iter()
         .par_tasks()
@@ -72,15 +72,15 @@ pub(crate) fn kernel_sums(
             let mut cnt = 0;
             let ids = &hi.id[nl.start[i] as usize..];
             for (&j, &id) in nl.of(i).iter().zip(ids) {
-                let pair = half[id as usize];
-                if !pair.used {
+                let bits = flags[id as usize];
+                if bits & USED == 0 {
                     continue;
                 }
-                let pair = pair.seen((j as usize) < i);
+                let pair = half[id as usize].seen((j as usize) < i);
                 let j = j as usize;
                 let vj = vol[j];
                 g += vj * pair.w;
-                if pair.r > 0.0 {
+                if bits & APART != 0 {
                     let grad = pair.xij * pair.dw_r;
                     m += outer(-pair.xij, grad) * vj;
                     gv += outer(p.vel[j] - vi, grad) * vj;

@@ -12,25 +12,27 @@ use crate::math::Vector;
 use crate::neighbours::{HalfIndex, NeighbourLists};
 use crate::particles::Particles;
 
-/// One same-body pair (i, j), i < j, as the kernel sums leave it for the forces: the quotients
-/// dW/dr / r and x_ij / r are taken once here, so no later stage divides by r again (both are 0
-/// for coincident particles, which every sum skips).
+/// One same-body pair (i, j), i < j, as the kernel sums leave it for the forces, in 32 bytes
+/// (two to a cache line; its flags are apart, in `PairCache::flags`): the quotient dW/dr / r is
+/// taken once here (0 for coincident particles, which every sum skips); r and x_ij / r are
+/// taken again where the hourglass force needs them, by the same operations, so to the same
+/// bits.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct HalfPair {
     /// x_ij = x_i − x_j.
     pub xij: Vector,
-    /// Unit vector x_ij / r.
-    pub e: Vector,
-    pub r: f64,
     pub w: f64,
     /// dW/dr / r: the kernel gradient is x_ij times this.
     pub dw_r: f64,
-    /// Reference positions within the kernel support (`NeighbourLists::near_ref`).
-    pub near_ref: bool,
-    /// Inside the kernel support with W or dW/dr non-zero: the lists reach a skin beyond the
-    /// support, and the pairs out there would add exact zeros.
-    pub used: bool,
 }
+
+/// Inside the kernel support with W or dW/dr non-zero: the lists reach a skin beyond the
+/// support, and the pairs out there would add exact zeros.
+pub(crate) const USED: u8 = 1;
+/// Reference positions within the kernel support (`NeighbourLists::near_ref`).
+pub(crate) const NEAR_REF: u8 = 2;
+/// r > 0: the particles are not coincident.
+pub(crate) const APART: u8 = 4;
 
 impl HalfPair {
     /// The pair seen from its higher-index particle when `flip`: x_ij and e_ij change sign.
@@ -38,9 +40,14 @@ impl HalfPair {
     pub fn seen(mut self, flip: bool) -> HalfPair {
         if flip {
             self.xij = -self.xij;
-            self.e = -self.e;
         }
         self
+    }
+
+    /// The distance r, as `fill_half_pairs` took it.
+    #[inline]
+    pub fn r(&self) -> f64 {
+        self.xij.norm_squared().sqrt()
     }
 }
 
@@ -61,6 +68,9 @@ pub(crate) struct Side {
 pub(crate) struct PairCache {
     /// Pairs by id.
     pub half: Vec<HalfPair>,
+    /// Each pair's `USED`, `NEAR_REF` and `APART` bits, by id: a gather reads one byte to skip
+    /// a pair out of the support instead of its record.
+    pub flags: Vec<u8>,
     /// Used pairs, laid out like the neighbour rows.
     pub sides: Vec<Side>,
     /// Pairs used in each particle's row.
@@ -97,13 +107,14 @@ pub(crate) fn rows_mut<'a, T: Default + Clone>(
     rows
 }
 
-/// Evaluates every same-body pair once into `half`, by id.
+/// Evaluates every same-body pair once into `half`, and its bits into `flags`, by id.
 pub(crate) fn fill_half_pairs(
     p: &Particles,
     nl: &NeighbourLists,
     hi: &HalfIndex,
     k: &Kernel,
     half: &mut Vec<HalfPair>,
+    flags: &mut Vec<u8>,
 ) {
     if hi.start.last().is_none_or(|&s| s == 0) {
         return;
@@ -111,35 +122,28 @@ pub(crate) fn fill_half_pairs(
     let r2max = k.radius() * k.radius();
     rows_mut(half, &hi.start)
         .into_par_iter()
+        .zip(rows_mut(flags, &hi.start))
         .par_tasks()
         .enumerate()
-        .for_each(|(i, row)| {
+        .for_each(|(i, (row, bits))| {
             let xi = p.pos[i];
             let u = hi.upper[i] as usize;
             let js = hi.upper_of(nl, i);
-            for ((out, &j), &near_ref) in row.iter_mut().zip(js).zip(&nl.near_ref[u..]) {
+            let each = row.iter_mut().zip(bits.iter_mut()).zip(js);
+            for (((out, bit), &j), &near_ref) in each.zip(&nl.near_ref[u..]) {
                 let xij = xi - p.pos[j as usize];
                 let r2 = xij.norm_squared();
                 if r2 >= r2max {
-                    out.used = false;
+                    *bit = 0;
                     continue;
                 }
                 let r = r2.sqrt();
                 let (w, dw) = k.w_dw(r);
-                let (mut dw_r, mut e) = (0.0, Vector::zeros());
-                if r > 0.0 {
-                    dw_r = dw / r;
-                    e = xij / r;
-                }
-                *out = HalfPair {
-                    xij,
-                    e,
-                    r,
-                    w,
-                    dw_r,
-                    near_ref,
-                    used: !(w == 0.0 && dw == 0.0),
-                };
+                let dw_r = if r > 0.0 { dw / r } else { 0.0 };
+                *out = HalfPair { xij, w, dw_r };
+                *bit = if w == 0.0 && dw == 0.0 { 0 } else { USED }
+                    | if near_ref { NEAR_REF } else { 0 }
+                    | if r > 0.0 { APART } else { 0 };
             }
         });
 }
@@ -149,8 +153,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn half_pair_fills_one_cache_line() {
-        assert_eq!(std::mem::size_of::<HalfPair>(), 64);
+    fn two_half_pairs_fill_one_cache_line() {
+        assert_eq!(std::mem::size_of::<HalfPair>(), 32);
     }
 
     #[test]
@@ -166,25 +170,19 @@ mod tests {
             let (w, dw) = k.w_dw(r);
             (xij, xij / r, r, w, dw / r)
         };
-        let (xij, e, r, w, dw_r) = eval(a, b);
-        let turned = HalfPair {
-            xij,
-            e,
-            r,
-            w,
-            dw_r,
-            near_ref: true,
-            used: true,
-        }
-        .seen(true);
+        let (xij, _, r, w, dw_r) = eval(a, b);
+        let pair = HalfPair { xij, w, dw_r };
+        assert_eq!(pair.r().to_bits(), r.to_bits());
+        let turned = pair.seen(true);
         let (xji, eji, rji, wji, dw_rji) = eval(b, a);
+        let e = turned.xij / turned.r();
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(
-            bits(&[turned.xij.x, turned.xij.y, turned.e.x, turned.e.y]),
+            bits(&[turned.xij.x, turned.xij.y, e.x, e.y]),
             bits(&[xji.x, xji.y, eji.x, eji.y])
         );
         assert_eq!(
-            bits(&[turned.r, turned.w, turned.dw_r]),
+            bits(&[turned.r(), turned.w, turned.dw_r]),
             bits(&[rji, wji, dw_rji])
         );
     }
