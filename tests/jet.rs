@@ -119,6 +119,14 @@ fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
     // The grain is braked in the stagnation zone, never sped up past the jet.
     let speed = rides[0]["contact_speed_m_s"].as_f64().unwrap();
     assert!(speed > 0.0 && speed < 300.0, "{speed}");
+    // On its way in it was faster the farther from the wall, and at 0.125 d from contact
+    // already near its contact speed.
+    let before = rides[0]["speed_before_contact"].as_array().unwrap();
+    let at = |k: usize| before[k]["speed_m_s"].as_f64().unwrap();
+    assert_eq!(before.len(), 6);
+    assert_eq!(before[0]["distance_d"], 4.0);
+    assert!((1..6).all(|k| at(k) <= at(k - 1)), "{before:?}");
+    assert!(at(0) < 300.0 && at(5) >= speed - 50.0, "{before:?}");
     for (args, needle) in [
         (vec!["--across", "7"], "--across"),
         (vec!["--jet-speed-m-s=-1"], "--jet-speed-m-s"),

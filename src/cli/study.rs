@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use anyhow::bail;
 use grit_erosion::studies::settle::{settle_study, SettleRow};
 use grit_sph::coupling::DEFAULT_SWITCH_POROSITY;
-use grit_sph::verification::jet_grain::{self, GrainRide, RcScene};
+use grit_sph::verification::jet_grain::{self, GrainRide, RcScene, BEFORE_CONTACT_D, GRAIN_D};
 
 use super::output::say;
 use super::sample::SceneArgs;
@@ -53,7 +53,8 @@ enum Study {
         /// Worker threads of the engine (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
-        /// Print {scene, rides: [{label, contact_speed_m_s}]} as JSON.
+        /// Print {scene, rides: [{label, contact_speed_m_s, speed_before_contact: [{distance_d,
+        /// speed_m_s}]}]} as JSON.
         #[arg(long)]
         json: bool,
     },
@@ -116,7 +117,22 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             if json {
                 let rides: Vec<_> = rides
                     .iter()
-                    .map(|r| serde_json::json!({"label": r.label, "contact_speed_m_s": r.contact_speed_m_s}))
+                    .map(|r| {
+                        let before: Vec<_> = BEFORE_CONTACT_D
+                            .iter()
+                            .map(|&d| {
+                                serde_json::json!({
+                                    "distance_d": d,
+                                    "speed_m_s": r.speed_before_contact(d * GRAIN_D),
+                                })
+                            })
+                            .collect();
+                        serde_json::json!({
+                            "label": r.label,
+                            "contact_speed_m_s": r.contact_speed_m_s,
+                            "speed_before_contact": before,
+                        })
+                    })
                     .collect();
                 let scene = serde_json::json!({
                     "across": across,
@@ -133,9 +149,25 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                 return Ok(ExitCode::SUCCESS);
             }
             say!("jet {jet_speed_m_s} m/s, b/dx {across}, grain released at {release_ratio} x the jet's speed");
-            say!("{:<14} {:>18}", "grain", "contact speed m/s");
+            let heads: String = BEFORE_CONTACT_D
+                .iter()
+                .map(|d| format!(" {:>8}", format!("{d} d")))
+                .collect();
+            say!(
+                "{:<14} {:>18}   speed (m/s) this far from contact:",
+                "grain",
+                "contact speed m/s"
+            );
+            say!("{:<14} {:>18}  {heads}", "", "");
             for r in &rides {
-                say!("{:<14} {:>18.1}", r.label, r.contact_speed_m_s);
+                let speeds: String = BEFORE_CONTACT_D
+                    .iter()
+                    .map(|&d| match r.speed_before_contact(d * GRAIN_D) {
+                        Some(v) => format!(" {v:>8.1}"),
+                        None => format!(" {:>8}", "-"),
+                    })
+                    .collect();
+                say!("{:<14} {:>18.1}  {speeds}", r.label, r.contact_speed_m_s);
             }
             say!("the paper: 166 m/s unresolved at R_c = 2.0 d, 162 m/s resolved");
             Ok(ExitCode::SUCCESS)

@@ -24,8 +24,11 @@ pub const PAPER_CONTACT_SPEED: f64 = 166.0;
 /// The paper's contact speed of the fully resolved grain (m/s; its Fig. 11).
 pub const PAPER_RESOLVED_SPEED: f64 = 162.0;
 /// Grain diameter (m) and density (kg/m³): the paper's garnet-like abrasive.
-const GRAIN_D: f64 = 0.2e-3;
+pub const GRAIN_D: f64 = 0.2e-3;
 const GRAIN_RHO: f64 = 4120.0;
+/// Distances before contact, in grain diameters, at which `grit study rc` reports a ride's speed:
+/// where the grain loses its speed on the way in.
+pub const BEFORE_CONTACT_D: [f64; 6] = [4.0, 2.0, 1.0, 0.5, 0.25, 0.125];
 /// Time the jet runs before the grain is released, in transit times b/v after its head reaches
 /// the wall: the jet on a wall's force has settled by then (`jet_wall`'s window opens at 6).
 const SETTLE_B_OVER_V: f64 = 6.0;
@@ -41,6 +44,23 @@ pub struct GrainRide {
     pub contact_speed_m_s: f64,
     /// Time since release (µs) and the grain's downward speed (m/s), every step.
     pub trace: (Vec<f64>, Vec<f64>),
+    /// The distance the grain still had to go to contact (m), at each step of `trace`.
+    pub to_contact_m: Vec<f64>,
+}
+
+impl GrainRide {
+    /// The grain's downward speed (m/s) when it was `distance_m` from contact, interpolated
+    /// linearly between the steps around it; None beyond the ride's start.
+    pub fn speed_before_contact(&self, distance_m: f64) -> Option<f64> {
+        let (d, v) = (&self.to_contact_m, &self.trace.1);
+        // The distance falls along the ride: the first step at or within it, and the one before.
+        let k = d.iter().position(|&x| x <= distance_m)?;
+        if k == 0 {
+            return (d[0] == distance_m).then_some(v[0]);
+        }
+        let f = (d[k - 1] - distance_m) / (d[k - 1] - d[k]);
+        Some(v[k - 1] + f * (v[k] - v[k - 1]))
+    }
 }
 
 /// A steady jet on a wall, `n` particles across, at `speed` m/s: the world the grains are
@@ -75,6 +95,7 @@ fn follow(
     let top = nozzle_top(&w)?;
     let t0 = w.time();
     let mut trace = (Vec::new(), Vec::new());
+    let mut to_contact_m = Vec::new();
     // A grain slower than a tenth of the jet's speed is stuck, not riding.
     let t_max = t0 + 10.0 * top / release_speed.max(0.1 * w.inflows()[0].nozzle.speed_m_s);
     loop {
@@ -86,11 +107,13 @@ fn follow(
         };
         trace.0.push((w.time() - t0) * 1e6);
         trace.1.push(-vel.y);
+        to_contact_m.push((pos.y - r - contact_gap).max(0.0));
         if pos.y <= r + contact_gap {
             return Ok(GrainRide {
                 label,
                 contact_speed_m_s: vel.norm(),
                 trace,
+                to_contact_m,
             });
         }
         if w.time() > t_max {
@@ -340,5 +363,24 @@ pub fn rides_chart(scene: &RcScene, rides: &[GrainRide]) -> Chart {
                 reference: false,
             })
             .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_speed_before_contact_is_read_between_the_steps_around_it() {
+        let ride = GrainRide {
+            label: "test".into(),
+            contact_speed_m_s: 100.0,
+            trace: (vec![0.0, 1.0, 2.0, 3.0], vec![400.0, 300.0, 200.0, 100.0]),
+            to_contact_m: vec![3e-4, 2e-4, 1e-4, 0.0],
+        };
+        assert_eq!(ride.speed_before_contact(3e-4), Some(400.0));
+        assert!((ride.speed_before_contact(1.5e-4).unwrap() - 250.0).abs() < 1e-9);
+        assert_eq!(ride.speed_before_contact(0.0), Some(100.0));
+        assert_eq!(ride.speed_before_contact(4e-4), None);
     }
 }
