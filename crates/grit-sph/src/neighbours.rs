@@ -10,6 +10,7 @@ use crate::contact::ContactPair;
 use crate::kernel::Kernel;
 use crate::math::Vector;
 use crate::particles::{Particles, BOUNDARY};
+use crate::stages::rows_mut;
 
 /// Neighbour lists in compressed rows: the neighbours of `i` are `list[start[i]..start[i+1]]`,
 /// in increasing index order, so every sum over them runs in one fixed order.
@@ -131,6 +132,12 @@ impl Cells {
     }
 }
 
+/// Rows one rayon task of the neighbour search takes at least, as the stages' smallest task;
+/// without an upper bound (the stages' `par_tasks`) it ran faster here.
+const ROWS_PER_TASK: usize = 64;
+/// Entries a row is allocated with: above the 60 or so a dense lattice lists within the reach.
+const ROW_CAPACITY: usize = 96;
+
 /// Builds neighbour lists with a cell list of cell size `radius`.
 ///
 /// `searcher[i]` says whether `i` gets a list; `candidate[j]` whether `j` can be listed;
@@ -157,12 +164,15 @@ pub fn build(
     let r2 = radius * radius;
     let rows: Vec<Vec<u32>> = (0..pos.len())
         .into_par_iter()
+        .with_min_len(ROWS_PER_TASK)
         .map(|i| {
             if !searcher[i] {
                 return Vec::new();
             }
             let (cx, cy) = key(&pos[i]);
-            let mut out = Vec::new();
+            // Room for a dense lattice's row at once: growing it by doubling took most of the
+            // search's time, and more with two threads, in the allocator.
+            let mut out = Vec::with_capacity(ROW_CAPACITY);
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     for &j in cells.members((cx + dx, cy + dy)) {
@@ -181,11 +191,16 @@ pub fn build(
         .collect();
     let mut start = Vec::with_capacity(pos.len() + 1);
     start.push(0u32);
-    let mut list = Vec::with_capacity(rows.iter().map(Vec::len).sum());
-    for r in rows {
-        list.extend_from_slice(&r);
-        start.push(list.len() as u32);
+    for r in &rows {
+        start.push(start[start.len() - 1] + r.len() as u32);
     }
+    // Copied into place in parallel, each row by its own task.
+    let mut list = Vec::new();
+    rows_mut(&mut list, &start)
+        .into_par_iter()
+        .zip(rows)
+        .with_min_len(ROWS_PER_TASK)
+        .for_each(|(dst, src)| dst.copy_from_slice(&src));
     NeighbourLists {
         start,
         list,
@@ -286,16 +301,17 @@ pub(crate) fn build_for_bodies(
     let mut same = build(&p.pos, &deformable, &deformable, radius, |i, j| {
         body[i] == body[j]
     });
-    let near_ref: Vec<Vec<bool>> = (0..n)
+    let mut near_ref = Vec::new();
+    rows_mut(&mut near_ref, &same.start)
         .into_par_iter()
-        .map(|i| {
-            same.of(i)
-                .iter()
-                .map(|&j| (p.x_ref[i] - p.x_ref[j as usize]).norm() < support)
-                .collect()
-        })
-        .collect();
-    same.near_ref = near_ref.concat();
+        .with_min_len(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(i, row)| {
+            for (out, &j) in row.iter_mut().zip(same.of(i)) {
+                *out = (p.x_ref[i] - p.x_ref[j as usize]).norm() < support;
+            }
+        });
+    same.near_ref = near_ref;
     let half = HalfIndex::new(&same);
     let contact = contacts
         .iter()
@@ -410,12 +426,17 @@ impl HalfIndex {
                 .expect("same-body lists are symmetric");
             start[j] + (nl.start[j] + at as u32 - upper[j])
         };
-        let id: Vec<u32> = (0..n)
+        let mut id = Vec::new();
+        rows_mut(&mut id, &nl.start)
             .into_par_iter()
-            .flat_map_iter(|i| {
-                (nl.start[i] as usize..nl.start[i + 1] as usize).map(move |k| id_of(i, k))
-            })
-            .collect();
+            .with_min_len(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(i, row)| {
+                let first = nl.start[i] as usize;
+                for (k, out) in row.iter_mut().enumerate() {
+                    *out = id_of(i, first + k);
+                }
+            });
         HalfIndex { start, upper, id }
     }
 

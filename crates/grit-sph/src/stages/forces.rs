@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{rows_mut, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
+use super::pairs::{row_blocks, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
 use super::{ParTasks, SphView, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{Matrix, Vector};
 use crate::neighbours::HalfIndex;
@@ -79,14 +79,14 @@ pub(crate) fn forces(
         Vec::new()
     };
     let hourglass_on = |pair: &HalfPair| alpha > 0.0 && pair.w > 0.0;
-    let rows = if any_pairs {
-        rows_mut(shared, &hi.start)
+    let blocks = if any_pairs {
+        row_blocks(shared, &hi.start)
     } else {
         Vec::new()
     };
-    rows.into_par_iter()
-        .par_tasks()
-        .enumerate()
+    blocks
+        .into_par_iter()
+        .flat_map_iter(|rows| rows.rows())
         .for_each(|(i, row)| {
             let js = hi.upper_of(nl, i);
             let at = hi.start[i] as usize;
@@ -137,41 +137,44 @@ pub(crate) fn forces(
             }
         });
     let shared = &*shared;
-    let out: Vec<ParticleForce> = (0..p.len())
-        .into_par_iter()
+    let gather = |i: usize| {
+        if !is_active(i) {
+            return ParticleForce {
+                acc: if moving(i) { g } else { Vector::zeros() },
+                hourglass_work: 0.0,
+            };
+        }
+        let vi = p.vel[i];
+        let mut a = Vector::zeros();
+        let mut fhg = Vector::zeros();
+        for &Side { j, id } in cache.of(nl, i) {
+            let f = shared[id as usize];
+            let (stress, hourglass) = if (j as usize) < i {
+                (-f.stress, -f.hourglass)
+            } else {
+                (f.stress, f.hourglass)
+            };
+            a += stress * p.mass[j as usize];
+            fhg -= hourglass;
+        }
+        let acc = a + fhg / p.mass[i] + g;
+        ParticleForce {
+            acc,
+            hourglass_work: fhg.dot(&vi) * dt,
+        }
+    };
+    // Written in place; the work is then summed in particle order, whatever the threads.
+    let n = p.len();
+    accel.resize(n, Vector::zeros());
+    let mut work = vec![0.0; n];
+    accel
+        .par_iter_mut()
+        .zip(work.par_iter_mut())
         .par_tasks()
-        .map(|i| {
-            if !is_active(i) {
-                return ParticleForce {
-                    acc: if moving(i) { g } else { Vector::zeros() },
-                    hourglass_work: 0.0,
-                };
-            }
-            let vi = p.vel[i];
-            let mut a = Vector::zeros();
-            let mut fhg = Vector::zeros();
-            for &Side { j, id } in cache.of(nl, i) {
-                let f = shared[id as usize];
-                let (stress, hourglass) = if (j as usize) < i {
-                    (-f.stress, -f.hourglass)
-                } else {
-                    (f.stress, f.hourglass)
-                };
-                a += stress * p.mass[j as usize];
-                fhg -= hourglass;
-            }
-            let acc = a + fhg / p.mass[i] + g;
-            ParticleForce {
-                acc,
-                hourglass_work: fhg.dot(&vi) * dt,
-            }
-        })
-        .collect();
-    accel.clear();
-    let mut hg = 0.0;
-    for f in out {
-        accel.push(f.acc);
-        hg += f.hourglass_work;
-    }
-    hg
+        .enumerate()
+        .for_each(|(i, (acc, w))| {
+            let f = gather(i);
+            (*acc, *w) = (f.acc, f.hourglass_work);
+        });
+    work.iter().fold(0.0, |hg, w| hg + w)
 }

@@ -6,8 +6,8 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{fill_half_pairs, rows_mut, PairCache, Side, APART, USED};
-use super::{ParTasks, SphView, MIN_SUPPORT_NEIGHBOURS};
+use super::pairs::{fill_half_pairs, row_blocks, PairCache, Side, APART, ROWS_PER_BLOCK, USED};
+use super::{SphView, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{outer, Matrix};
 use crate::neighbours::HalfIndex;
 
@@ -51,68 +51,74 @@ pub(crate) fn kernel_sums(
     let vol = &sums.vol;
     fill_half_pairs(p, nl, hi, k, &mut cache.half, &mut cache.flags);
     let (half, flags) = (&cache.half, &cache.flags);
-    let out: Vec<ParticleSums> = rows_mut(&mut cache.sides, &nl.start)
-        .into_par_iter()
-        .par_tasks()
-        .enumerate()
-        .map(|(i, row)| {
-            let bi = p.body[i];
-            if !bc[bi as usize].deformable {
-                return ParticleSums {
-                    shepard: 1.0,
-                    lcorr: Matrix::identity(),
-                    gradv: Matrix::zeros(),
-                    pairs: 0,
-                };
-            }
-            let mut g = vol[i] * w0;
-            let mut m = Matrix::zeros();
-            let vi = p.vel[i];
-            let mut gv = Matrix::zeros();
-            let mut cnt = 0;
-            let ids = &hi.id[nl.start[i] as usize..];
-            for (&j, &id) in nl.of(i).iter().zip(ids) {
-                let bits = flags[id as usize];
-                if bits & USED == 0 {
-                    continue;
-                }
-                let pair = half[id as usize].seen((j as usize) < i);
-                let j = j as usize;
-                let vj = vol[j];
-                g += vj * pair.w;
-                if bits & APART != 0 {
-                    let grad = pair.xij * pair.dw_r;
-                    m += outer(-pair.xij, grad) * vj;
-                    gv += outer(p.vel[j] - vi, grad) * vj;
-                }
-                row[cnt] = Side { j: j as u32, id };
-                cnt += 1;
-            }
-            let lcorr = correction(m);
-            // Fragments fly ballistically: no velocity gradient.
-            let gradv = if cnt < MIN_SUPPORT_NEIGHBOURS as usize {
-                Matrix::zeros()
-            } else {
-                gv * lcorr.transpose()
+    let particle_sums = |i: usize, row: &mut [Side]| {
+        let bi = p.body[i];
+        if !bc[bi as usize].deformable {
+            return ParticleSums {
+                shepard: 1.0,
+                lcorr: Matrix::identity(),
+                gradv: Matrix::zeros(),
+                pairs: 0,
             };
-            ParticleSums {
-                shepard: g,
-                lcorr,
-                gradv,
-                pairs: cnt as u32,
+        }
+        let mut g = vol[i] * w0;
+        let mut m = Matrix::zeros();
+        let vi = p.vel[i];
+        let mut gv = Matrix::zeros();
+        let mut cnt = 0;
+        let ids = &hi.id[nl.start[i] as usize..];
+        for (&j, &id) in nl.of(i).iter().zip(ids) {
+            let bits = flags[id as usize];
+            if bits & USED == 0 {
+                continue;
             }
-        })
-        .collect();
-    sums.shepard.clear();
-    sums.lcorr.clear();
-    sums.gradv.clear();
-    cache.count.clear();
-    for o in out {
-        sums.shepard.push(o.shepard);
-        sums.lcorr.push(o.lcorr);
-        sums.gradv.push(o.gradv);
-        cache.count.push(o.pairs);
-    }
+            let pair = half[id as usize].seen((j as usize) < i);
+            let j = j as usize;
+            let vj = vol[j];
+            g += vj * pair.w;
+            if bits & APART != 0 {
+                let grad = pair.xij * pair.dw_r;
+                m += outer(-pair.xij, grad) * vj;
+                gv += outer(p.vel[j] - vi, grad) * vj;
+            }
+            row[cnt] = Side { j: j as u32, id };
+            cnt += 1;
+        }
+        let lcorr = correction(m);
+        // Fragments fly ballistically: no velocity gradient.
+        let gradv = if cnt < MIN_SUPPORT_NEIGHBOURS as usize {
+            Matrix::zeros()
+        } else {
+            gv * lcorr.transpose()
+        };
+        ParticleSums {
+            shepard: g,
+            lcorr,
+            gradv,
+            pairs: cnt as u32,
+        }
+    };
+    // Each particle's results go straight to their places, block by block.
+    let n = p.len();
+    sums.shepard.resize(n, 0.0);
+    sums.lcorr.resize(n, Matrix::zeros());
+    sums.gradv.resize(n, Matrix::zeros());
+    cache.count.resize(n, 0);
+    let outs = sums
+        .shepard
+        .par_chunks_mut(ROWS_PER_BLOCK)
+        .zip(sums.lcorr.par_chunks_mut(ROWS_PER_BLOCK))
+        .zip(sums.gradv.par_chunks_mut(ROWS_PER_BLOCK))
+        .zip(cache.count.par_chunks_mut(ROWS_PER_BLOCK));
+    row_blocks(&mut cache.sides, &nl.start)
+        .into_par_iter()
+        .zip(outs)
+        .for_each(|(rows, (((shepard, lcorr), gradv), count))| {
+            for (k, (i, row)) in rows.rows().enumerate() {
+                let o = particle_sums(i, row);
+                (shepard[k], lcorr[k], gradv[k], count[k]) = (o.shepard, o.lcorr, o.gradv, o.pairs);
+            }
+        });
 }
 
 /// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a

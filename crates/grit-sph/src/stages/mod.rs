@@ -32,6 +32,7 @@ pub(crate) use forces::{forces, PairForce};
 pub(crate) use integrate::{integrate, Blowup};
 pub(crate) use interface::{interface_continuity, interface_forces};
 pub(crate) use kernel_sums::{kernel_sums, KernelSums};
+pub(crate) use pairs::rows_mut;
 pub(crate) use pairs::PairCache;
 pub(crate) use rigid::rigid;
 pub(crate) use stress::stress;

@@ -6,7 +6,6 @@
 
 use rayon::prelude::*;
 
-use super::ParTasks;
 use crate::kernel::Kernel;
 use crate::math::Vector;
 use crate::neighbours::{HalfIndex, NeighbourLists};
@@ -107,6 +106,66 @@ pub(crate) fn rows_mut<'a, T: Default + Clone>(
     rows
 }
 
+/// Rows of the pair cache one task takes in the loops over its rows.
+pub(crate) const ROWS_PER_BLOCK: usize = 64;
+
+/// A block of `ROWS_PER_BLOCK` consecutive rows of a buffer laid out by `start` (row i is
+/// `start[i]..start[i + 1]`): its first row and its entries. The task that takes it cuts the
+/// rows itself (`rows`), so no serial pass over every row runs before the parallel loop (on a
+/// virtual machine such a pass lets the idle worker fall asleep: docs/performance.md, "Why two
+/// threads give 1.6").
+pub(crate) struct RowBlock<'a, T> {
+    first: usize,
+    entries: &'a mut [T],
+    start: &'a [u32],
+}
+
+impl<'a, T> RowBlock<'a, T> {
+    /// The block's rows in order, with their indices.
+    pub fn rows(self) -> impl Iterator<Item = (usize, &'a mut [T])> {
+        let RowBlock {
+            first,
+            mut entries,
+            start,
+        } = self;
+        let last = (first + ROWS_PER_BLOCK).min(start.len() - 1);
+        (first..last).map(move |i| {
+            let (row, rest) =
+                std::mem::take(&mut entries).split_at_mut((start[i + 1] - start[i]) as usize);
+            entries = rest;
+            (i, row)
+        })
+    }
+}
+
+/// `buf` cut into blocks of `ROWS_PER_BLOCK` rows of `start`'s layout, as many as
+/// `par_chunks_mut(ROWS_PER_BLOCK)` cuts a per-row array into. `buf` grows to fit and is never
+/// cleared: every row is written before it is read.
+pub(crate) fn row_blocks<'a, T: Default + Clone>(
+    buf: &'a mut Vec<T>,
+    start: &'a [u32],
+) -> Vec<RowBlock<'a, T>> {
+    let total = start.last().map_or(0, |&s| s as usize);
+    if buf.len() < total {
+        buf.resize(total, T::default());
+    }
+    let n = start.len().saturating_sub(1);
+    let mut blocks = Vec::with_capacity(n.div_ceil(ROWS_PER_BLOCK));
+    let mut rest = buf.as_mut_slice();
+    for first in (0..n).step_by(ROWS_PER_BLOCK) {
+        let last = (first + ROWS_PER_BLOCK).min(n);
+        let (entries, tail) =
+            std::mem::take(&mut rest).split_at_mut((start[last] - start[first]) as usize);
+        rest = tail;
+        blocks.push(RowBlock {
+            first,
+            entries,
+            start,
+        });
+    }
+    blocks
+}
+
 /// Evaluates every same-body pair once into `half`, and its bits into `flags`, by id.
 pub(crate) fn fill_half_pairs(
     p: &Particles,
@@ -120,12 +179,11 @@ pub(crate) fn fill_half_pairs(
         return;
     }
     let r2max = k.radius() * k.radius();
-    rows_mut(half, &hi.start)
+    row_blocks(half, &hi.start)
         .into_par_iter()
-        .zip(rows_mut(flags, &hi.start))
-        .par_tasks()
-        .enumerate()
-        .for_each(|(i, (row, bits))| {
+        .zip(row_blocks(flags, &hi.start))
+        .flat_map_iter(|(rows, bits)| rows.rows().zip(bits.rows()))
+        .for_each(|((i, row), (_, bits))| {
             let xi = p.pos[i];
             let u = hi.upper[i] as usize;
             let js = hi.upper_of(nl, i);

@@ -404,8 +404,12 @@ impl World {
             self.filter_density_with(bc);
         }
         // Deleted: solids at D ≥ 1, free fluid particles outside their fluid's density range.
+        use crate::stages::ParTasks;
+        use rayon::prelude::*;
         let p = &self.particles;
         let failed: Vec<bool> = (0..p.len())
+            .into_par_iter()
+            .par_tasks()
             .map(|i| {
                 let free_fluid = bc[p.body[i] as usize]
                     .fluid
