@@ -385,7 +385,8 @@ impl ImpactParams {
         let lowest = rotated.iter().map(|v| v.y).fold(f64::INFINITY, f64::min);
         let aim_x = (u_aim - 0.5) * self.distribution_range_dg * self.grain_diameter_m;
         let a = self.angle_deg.to_radians();
-        let dir = Vector::new(a.cos(), -a.sin());
+        let (sin_a, cos_a) = grit_sph::math::sin_cos(a);
+        let dir = Vector::new(cos_a, -sin_a);
         // Seed section 4: oblique grains are "shifted accordingly so that they hit the surface
         // around the midpoint". So the centroid is above the aim point when the lowest point
         // reaches y = 0. (Aiming the centroid path at y = 0 instead puts the touchdown
@@ -396,9 +397,9 @@ impl ImpactParams {
         let shift = if self.angle_deg == 90.0 {
             0.0
         } else {
-            -lowest / a.tan()
+            -lowest / grit_sph::math::tan(a)
         };
-        let back = (START_GAP_DX * self.spacing_m - lowest) / a.sin();
+        let back = (START_GAP_DX * self.spacing_m - lowest) / sin_a;
         let centre = Vector::new(aim_x + shift, 0.0) - dir * back;
         let vertices: Vec<[f64; 2]> = rotated
             .iter()

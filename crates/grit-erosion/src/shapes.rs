@@ -248,7 +248,8 @@ fn regular_polygon(n: usize) -> Vec<[f64; 2]> {
     (0..n)
         .map(|k| {
             let t = -PI / 2.0 + PI / n as f64 + 2.0 * PI * k as f64 / n as f64;
-            [t.cos(), t.sin()]
+            let (s, c) = grit_sph::math::sin_cos(t);
+            [c, s]
         })
         .collect()
 }

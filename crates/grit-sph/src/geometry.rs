@@ -30,7 +30,8 @@ impl Polygon {
         let vertices = (0..n)
             .map(|k| {
                 let t = phase + 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-                Vector::new(r * t.cos(), r * t.sin())
+                let (s, c) = crate::math::sin_cos(t);
+                Vector::new(r * c, r * s)
             })
             .collect();
         Polygon { vertices }

@@ -31,7 +31,7 @@ pub fn omega_cross(omega: f64, r: Vector) -> Vector {
 /// Rotates `v` by the angle `theta` (radians) counter-clockwise.
 #[inline]
 pub fn rotate(v: Vector, theta: f64) -> Vector {
-    let (s, c) = theta.sin_cos();
+    let (s, c) = sin_cos(theta);
     Vector::new(c * v.x - s * v.y, s * v.x + c * v.y)
 }
 
@@ -39,4 +39,38 @@ pub fn rotate(v: Vector, theta: f64) -> Vector {
 #[inline]
 pub fn outer(a: Vector, b: Vector) -> Matrix {
     Matrix::new(a.x * b.x, a.x * b.y, a.y * b.x, a.y * b.y)
+}
+
+// The transcendental functions every result goes through, from one software implementation
+// (the `libm` crate): the system's libm picks its own by CPU at load time, and a worker with
+// another CPU would then compute other bits (docs/design.md, "Rules the engine keeps").
+
+/// x^y.
+#[inline]
+pub fn pow(x: f64, y: f64) -> f64 {
+    libm::pow(x, y)
+}
+
+/// e^x.
+#[inline]
+pub fn exp(x: f64) -> f64 {
+    libm::exp(x)
+}
+
+/// The natural logarithm of x.
+#[inline]
+pub fn ln(x: f64) -> f64 {
+    libm::log(x)
+}
+
+/// (sin θ, cos θ).
+#[inline]
+pub fn sin_cos(theta: f64) -> (f64, f64) {
+    libm::sincos(theta)
+}
+
+/// tan θ.
+#[inline]
+pub fn tan(theta: f64) -> f64 {
+    libm::tan(theta)
 }

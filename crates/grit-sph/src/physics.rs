@@ -2,7 +2,7 @@
 //! plasticity, adiabatic heating, and Johnson–Cook fracture strain (eqs. 19–20).
 
 use crate::material::{JohnsonCook, JohnsonCookDamage};
-use crate::math::Matrix;
+use crate::math::{exp, ln, pow, Matrix};
 use crate::particles::von_mises;
 
 /// Homologous temperature T* = (T − Tref)/(Tmelt − Tref), clamped to [0, 1].
@@ -16,18 +16,18 @@ pub fn homologous_temperature(jc: &JohnsonCook, t: f64) -> f64 {
 /// logarithm never softens the material (docs/references.md#constitutive-forms).
 #[inline]
 pub fn jc_yield(jc: &JohnsonCook, eps_p: f64, rate: f64, t: f64) -> (f64, f64, f64) {
-    let hard = jc.a_pa + jc.b_pa * eps_p.max(0.0).powf(jc.n);
+    let hard = jc.a_pa + jc.b_pa * pow(eps_p.max(0.0), jc.n);
     let dhard = if eps_p > 0.0 {
-        jc.b_pa * jc.n * eps_p.powf(jc.n - 1.0)
+        jc.b_pa * jc.n * pow(eps_p, jc.n - 1.0)
     } else {
         0.0
     };
     let (rate_term, drate) = if rate > jc.ref_strain_rate_s {
-        (1.0 + jc.c * (rate / jc.ref_strain_rate_s).ln(), jc.c / rate)
+        (1.0 + jc.c * ln(rate / jc.ref_strain_rate_s), jc.c / rate)
     } else {
         (1.0, 0.0)
     };
-    let th = 1.0 - homologous_temperature(jc, t).powf(jc.m);
+    let th = 1.0 - pow(homologous_temperature(jc, t), jc.m);
     (
         hard * rate_term * th,
         dhard * rate_term * th,
@@ -121,11 +121,11 @@ pub fn fracture_strain(
     t: f64,
 ) -> f64 {
     let rate_term = if rate > d.ref_strain_rate_s {
-        1.0 + d.d4 * (rate / d.ref_strain_rate_s).ln()
+        1.0 + d.d4 * ln(rate / d.ref_strain_rate_s)
     } else {
         1.0
     };
-    let ef = (d.d1 + d.d2 * (d.d3 * triax).exp())
+    let ef = (d.d1 + d.d2 * exp(d.d3 * triax))
         * rate_term
         * (1.0 + d.d5 * homologous_temperature(jc, t));
     ef.max(MIN_FRACTURE_STRAIN)

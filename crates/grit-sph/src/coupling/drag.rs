@@ -4,6 +4,7 @@
 
 use crate::error::InputError;
 use crate::fluid::Fluid;
+use crate::math::pow;
 
 /// Reynolds number at and above which the Schiller–Naumann C_d is the constant 0.44 (eq. 48).
 pub const NEWTON_REYNOLDS: f64 = 1000.0;
@@ -22,7 +23,7 @@ pub fn reynolds(speed: f64, porosity: f64, diameter: f64, rho_f: f64, mu: f64) -
 #[inline]
 pub fn drag_coefficient(re: f64) -> f64 {
     if re < NEWTON_REYNOLDS {
-        24.0 / re * (1.0 + 0.15 * re.powf(0.687))
+        24.0 / re * (1.0 + 0.15 * pow(re, 0.687))
     } else {
         0.44
     }
@@ -32,7 +33,7 @@ pub fn drag_coefficient(re: f64) -> f64 {
 #[inline]
 pub fn drag_coefficient_times_re(re: f64) -> f64 {
     if re < NEWTON_REYNOLDS {
-        24.0 * (1.0 + 0.15 * re.powf(0.687))
+        24.0 * (1.0 + 0.15 * pow(re, 0.687))
     } else {
         0.44 * re
     }
@@ -59,7 +60,7 @@ pub fn drag_per_volume(
     } else {
         // 0.75 C_d ρ_f |v| ε^−1.65/d = 0.75 (C_d Re) μ ε^−2.65/d², Re = |v| ε ρ_f d/μ.
         let re = reynolds(speed, eps, diameter, rho_f, mu);
-        0.75 * drag_coefficient_times_re(re) * mu * eps.powf(-2.65) / (diameter * diameter)
+        0.75 * drag_coefficient_times_re(re) * mu * pow(eps, -2.65) / (diameter * diameter)
     }
 }
 

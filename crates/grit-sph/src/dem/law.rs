@@ -7,7 +7,7 @@ use crate::math::{perp, Vector};
 /// Damping ratio ξ = −ln e / √(π² + ln² e) that makes a linear spring–dashpot rebound with
 /// restitution coefficient `e` (docs/jet.md#dem-abrasives).
 pub fn damping_ratio(restitution: f64) -> f64 {
-    let l = restitution.ln();
+    let l = crate::math::ln(restitution);
     -l / (std::f64::consts::PI * std::f64::consts::PI + l * l).sqrt()
 }
 
