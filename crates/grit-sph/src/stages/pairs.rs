@@ -1,7 +1,7 @@
 //! The same-body pairs of a step, each evaluated once (`neighbours::HalfIndex`): the separation,
 //! the kernel W and dW/dr (seed eq. 4) of pair (i, j), i < j, seen from i. Particle j reads the
-//! same values turned round: x_ji = −x_ij and e_ji = −e_ij exactly, and W, dW/dr and r do not
-//! depend on the side, so each particle's sums get bitwise the terms they would from its own
+//! same values turned round: x_ji = −x_ij exactly (and so e_ji = −e_ij where the forces take
+//! it again), and W, dW/dr and r do not depend on the side, so each particle's sums get bitwise the terms they would from its own
 //! evaluation of the pair.
 
 use rayon::prelude::*;
@@ -34,7 +34,7 @@ pub(crate) const NEAR_REF: u8 = 2;
 pub(crate) const APART: u8 = 4;
 
 impl HalfPair {
-    /// The pair seen from its higher-index particle when `flip`: x_ij and e_ij change sign.
+    /// The pair seen from its higher-index particle when `flip`: x_ij changes sign.
     #[inline]
     pub fn seen(mut self, flip: bool) -> HalfPair {
         if flip {
@@ -86,24 +86,17 @@ impl PairCache {
 }
 
 /// `buf` cut into one mutable slice per row, row i of length `start[i + 1] − start[i]`, so the
-/// rows fill in parallel, each by its own owner. `buf` grows to fit and is never cleared: every
-/// row is written before it is read (a memset per step otherwise).
+/// rows fill in parallel, each by its own owner; `buf` grows as for `row_blocks`, whose blocks
+/// it cuts on the calling thread (for the neighbour rebuild, where one serial pass per rebuild
+/// costs nothing against the search).
 pub(crate) fn rows_mut<'a, T: Default + Clone>(
     buf: &'a mut Vec<T>,
-    start: &[u32],
+    start: &'a [u32],
 ) -> Vec<&'a mut [T]> {
-    let total = start.last().map_or(0, |&s| s as usize);
-    if buf.len() < total {
-        buf.resize(total, T::default());
-    }
-    let mut rows = Vec::with_capacity(start.len().saturating_sub(1));
-    let mut rest = buf.as_mut_slice();
-    for w in start.windows(2) {
-        let (row, tail) = rest.split_at_mut((w[1] - w[0]) as usize);
-        rows.push(row);
-        rest = tail;
-    }
-    rows
+    row_blocks(buf, start)
+        .into_iter()
+        .flat_map(|block| block.rows().map(|(_, row)| row))
+        .collect()
 }
 
 /// Rows of the pair cache one task takes in the loops over its rows.
