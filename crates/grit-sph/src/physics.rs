@@ -16,7 +16,38 @@ pub fn homologous_temperature(jc: &JohnsonCook, t: f64) -> f64 {
 /// logarithm never softens the material (docs/references.md#constitutive-forms).
 #[inline]
 pub fn jc_yield(jc: &JohnsonCook, eps_p: f64, rate: f64, t: f64) -> (f64, f64, f64) {
-    let hard = jc.a_pa + jc.b_pa * pow(eps_p.max(0.0), jc.n);
+    yield_softened(jc, eps_p, rate, thermal_softening(jc, t))
+}
+
+/// The thermal factor 1 − T*^m of Johnson–Cook yield (eq. 18).
+#[inline]
+pub fn thermal_softening(jc: &JohnsonCook, t: f64) -> f64 {
+    let ts = homologous_temperature(jc, t);
+    // 0^m is exactly 0 for m > 0: at room temperature the power is skipped, to the same bits.
+    if ts == 0.0 && jc.m > 0.0 {
+        1.0
+    } else {
+        1.0 - pow(ts, jc.m)
+    }
+}
+
+/// Johnson–Cook strain hardening A + B ε_p^n (eq. 18); the power is skipped, to the same bits,
+/// where ε_p = 0.
+#[inline]
+fn hardening(jc: &JohnsonCook, eps_p: f64) -> f64 {
+    let e = eps_p.max(0.0);
+    if e == 0.0 && jc.n > 0.0 {
+        jc.a_pa
+    } else {
+        jc.a_pa + jc.b_pa * pow(e, jc.n)
+    }
+}
+
+/// `jc_yield` with its thermal factor `th` (`thermal_softening`) given: the radial return takes it
+/// once per particle, not once per iteration.
+#[inline]
+fn yield_softened(jc: &JohnsonCook, eps_p: f64, rate: f64, th: f64) -> (f64, f64, f64) {
+    let hard = hardening(jc, eps_p);
     let dhard = if eps_p > 0.0 {
         jc.b_pa * jc.n * pow(eps_p, jc.n - 1.0)
     } else {
@@ -27,7 +58,6 @@ pub fn jc_yield(jc: &JohnsonCook, eps_p: f64, rate: f64, t: f64) -> (f64, f64, f
     } else {
         (1.0, 0.0)
     };
-    let th = 1.0 - pow(homologous_temperature(jc, t), jc.m);
     (
         hard * rate_term * th,
         dhard * rate_term * th,
@@ -61,7 +91,9 @@ pub fn radial_return(
     t: f64,
 ) -> Plastic {
     let seq = von_mises(&s_trial);
-    let (sy0, _, _) = jc_yield(jc, eps_p, 0.0, t);
+    let th = thermal_softening(jc, t);
+    // The elastic check needs the yield stress alone: no derivative, so no second power.
+    let sy0 = hardening(jc, eps_p) * th;
     if seq <= sy0 {
         return Plastic {
             sdev: s_trial,
@@ -71,7 +103,7 @@ pub fn radial_return(
     }
     // f(Δε) = seq − 3GΔε − σy(Δε) is decreasing; bracket the root in [0, seq/3G].
     let f = |de: f64| {
-        let (sy, dsde, dsdr) = jc_yield(jc, eps_p + de, de / dt, t);
+        let (sy, dsde, dsdr) = yield_softened(jc, eps_p + de, de / dt, th);
         (
             seq - 3.0 * shear * de - sy,
             -3.0 * shear - dsde - dsdr / dt,
