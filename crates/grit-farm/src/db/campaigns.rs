@@ -9,8 +9,8 @@ use sqlx::Row;
 use uuid::Uuid;
 
 use super::{
-    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, parse_uuid, NewCampaign,
-    NewJob, Store,
+    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, parse_uuid,
+    per_cell_and_sample, NewCampaign, NewJob, Store,
 };
 use crate::api::{
     AnyResults, CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress,
@@ -337,17 +337,12 @@ impl Store {
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let mut per_cell: Vec<BTreeMap<u32, Vec<Impact>>> = vec![BTreeMap::new(); cells.len()];
-        for r in &rows {
-            let cell = r.get::<i64, _>(0) as usize;
-            let sample = r.get::<i64, _>(1) as u32;
-            if let Some(m) = per_cell.get_mut(cell) {
-                m.entry(sample).or_default().push(Impact {
-                    grain_mass_kg: r.get(2),
-                    mass_loss_kg: r.get(3),
-                });
-            }
-        }
+        let per_cell = per_cell_and_sample(&rows, cells.len(), |r| {
+            Ok(Impact {
+                grain_mass_kg: r.get(2),
+                mass_loss_kg: r.get(3),
+            })
+        })?;
         // Cells that grew are planned as they are now, not as the spec first planned them.
         let plans = self.cell_plans(id).await?;
         let inputs: Vec<_> = cells

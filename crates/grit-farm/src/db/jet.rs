@@ -1,8 +1,6 @@
 //! The store's side of jet campaigns (docs/jet-campaigns.md): submitting one (cells and jobs
 //! whose unit is a slice), and its results from the stored slices.
 
-use std::collections::BTreeMap;
-
 use grit_erosion::campaign::{job_seed, JetCampaignSpec, Scene};
 use grit_erosion::jet::aggregate::{aggregate_jet_campaign, JetCellInput, JetSampleInput};
 use grit_erosion::jet::JetSlice;
@@ -10,7 +8,8 @@ use sqlx::Row;
 use uuid::Uuid;
 
 use super::{
-    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, NewCampaign, NewJob, Store,
+    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, per_cell_and_sample,
+    NewCampaign, NewJob, Store,
 };
 use crate::api::{CampaignCreated, JetResultsResponse, RawJetSample};
 use crate::error::{Error, Result};
@@ -117,16 +116,10 @@ impl Store {
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let mut per_cell: Vec<BTreeMap<u32, Vec<JetSlice>>> = vec![BTreeMap::new(); cells.len()];
-        for r in &rows {
-            let cell = r.get::<i64, _>(0) as usize;
-            let sample = r.get::<i64, _>(1) as u32;
-            let rec: JetSlice = serde_json::from_str(&r.get::<String, _>(2))
-                .map_err(|e| Error::Internal(format!("stored slice record: {e}")))?;
-            if let Some(m) = per_cell.get_mut(cell) {
-                m.entry(sample).or_default().push(rec);
-            }
-        }
+        let per_cell = per_cell_and_sample(&rows, cells.len(), |r| {
+            serde_json::from_str::<JetSlice>(&r.get::<String, _>(2))
+                .map_err(|e| Error::Internal(format!("stored slice record: {e}")))
+        })?;
         let inputs: Vec<JetCellInput> = cells
             .iter()
             .zip(per_cell)

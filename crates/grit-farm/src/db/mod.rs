@@ -161,6 +161,27 @@ async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool>
 }
 
 /// Parses a uuid the store wrote.
+/// A campaign's stored records, each row (cell index, sample index, …) taken by `take`, grouped
+/// per cell (`cells` of them) and per sample in the rows' order; rows of cells beyond `cells` are
+/// left out.
+fn per_cell_and_sample<T>(
+    rows: &[sqlx::sqlite::SqliteRow],
+    cells: usize,
+    take: impl Fn(&sqlx::sqlite::SqliteRow) -> Result<T>,
+) -> Result<Vec<std::collections::BTreeMap<u32, Vec<T>>>> {
+    use sqlx::Row;
+    let mut per_cell: Vec<std::collections::BTreeMap<u32, Vec<T>>> =
+        (0..cells).map(|_| Default::default()).collect();
+    for r in rows {
+        let cell = r.get::<i64, _>(0) as usize;
+        let sample = r.get::<i64, _>(1) as u32;
+        if let Some(m) = per_cell.get_mut(cell) {
+            m.entry(sample).or_default().push(take(r)?);
+        }
+    }
+    Ok(per_cell)
+}
+
 fn parse_uuid(s: &str) -> Result<Uuid> {
     Uuid::from_str(s).map_err(|e| Error::Internal(format!("stored id {s}: {e}")))
 }

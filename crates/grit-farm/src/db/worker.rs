@@ -706,6 +706,28 @@ async fn touch_worker(
     Ok(())
 }
 
+/// The order appended records keep (`store_impacts`, `store_slices`): record `n` of a job with
+/// `done` stored and `planned` in all is skipped (false) when already stored, taken (true) when
+/// it is the next, and refused, naming `field`, when it leaves a gap or passes the plan.
+fn is_next(unit: &str, n: u32, done: u32, planned: u32, field: String) -> Result<bool> {
+    if n <= done {
+        return Ok(false);
+    }
+    if n != done + 1 {
+        return Err(Error::invalid(
+            field,
+            format!("expected {unit} {} next, got {n}", done + 1),
+        ));
+    }
+    if n > planned {
+        return Err(Error::invalid(
+            field,
+            format!("the job plans only {planned} {unit}s"),
+        ));
+    }
+    Ok(true)
+}
+
 /// Appends impacts after those stored; ones already stored are skipped (a resumed job
 /// re-runs impacts past its checkpoint, and a retried heartbeat resends). Every record is
 /// checked before any is written, and the new ones go in with one statement. Returns the
@@ -721,20 +743,8 @@ async fn store_impacts(
     let mut new = Vec::with_capacity(impacts.len());
     for (i, rec) in impacts.iter().enumerate() {
         let field = |name: &str| format!("impacts[{i}].{name}");
-        if rec.impact <= done {
+        if !is_next("impact", rec.impact, done, held.planned, field("impact"))? {
             continue;
-        }
-        if rec.impact != done + 1 {
-            return Err(Error::invalid(
-                field("impact"),
-                format!("expected impact {} next, got {}", done + 1, rec.impact),
-            ));
-        }
-        if rec.impact > held.planned {
-            return Err(Error::invalid(
-                field("impact"),
-                format!("the job plans only {} impacts", held.planned),
-            ));
         }
         if !(rec.grain_mass_kg.is_finite() && rec.grain_mass_kg > 0.0) {
             return Err(Error::invalid(
@@ -782,20 +792,8 @@ async fn store_slices(
     let mut new = Vec::with_capacity(slices.len());
     for (i, rec) in slices.iter().enumerate() {
         let field = |name: &str| format!("slices[{i}].{name}");
-        if rec.slice <= done {
+        if !is_next("slice", rec.slice, done, held.planned, field("slice"))? {
             continue;
-        }
-        if rec.slice != done + 1 {
-            return Err(Error::invalid(
-                field("slice"),
-                format!("expected slice {} next, got {}", done + 1, rec.slice),
-            ));
-        }
-        if rec.slice > held.planned {
-            return Err(Error::invalid(
-                field("slice"),
-                format!("the job plans only {} slices", held.planned),
-            ));
         }
         if !rec.t_s.is_finite() {
             return Err(Error::invalid(field("sample.t_s"), "must be finite"));
@@ -878,4 +876,31 @@ pub(super) async fn reap(tx: &mut Transaction<'static, Sqlite>, now: i64) -> Res
         tracing::info!(jobs = n, "expired leases returned to the queue");
     }
     Ok(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refusal(r: Result<bool>) -> (String, String) {
+        match r {
+            Err(Error::Invalid { field, rule }) => (field, rule),
+            other => panic!("expected a refusal, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn appended_records_are_skipped_taken_or_refused_by_their_number() {
+        let f = || "slices[0].slice".to_string();
+        assert!(!is_next("slice", 2, 2, 5, f()).unwrap());
+        assert!(is_next("slice", 3, 2, 5, f()).unwrap());
+        assert_eq!(
+            refusal(is_next("slice", 4, 2, 5, f())),
+            (f(), "expected slice 3 next, got 4".to_string())
+        );
+        assert_eq!(
+            refusal(is_next("impact", 6, 5, 5, f())),
+            (f(), "the job plans only 5 impacts".to_string())
+        );
+    }
 }
