@@ -226,6 +226,11 @@ fn impact_bench_prints_its_fields_with_medians_of_repeats() {
     assert!((v["wall_s"].as_f64().unwrap() - 0.5 * (a + b)).abs() < 1e-12);
     for stage in ["kernel_sums", "forces", "stress", "contact", "neighbours"] {
         assert!(v["stages"][stage].as_f64().unwrap() > 0.0, "{stage}: {v}");
+        // The same stage on 1 thread, so each stage's speed-up can be read off.
+        assert!(
+            v["stages_1_thread"][stage].as_f64().unwrap() > 0.0,
+            "{stage} on 1 thread: {v}"
+        );
     }
     // The bare kernel-sum loop over the same pairs, timed in the same run.
     let c = &v["ceiling"];

@@ -360,9 +360,23 @@ fn impact(
         );
     }
     let total: f64 = b.stages.values().sum();
+    say!(
+        "  {:<14} {:>8} {:>7} {:>10} {:>8}",
+        "stage",
+        format!("{} thr", b.threads),
+        "share",
+        "1 thread",
+        "speed-up"
+    );
     for (k, v) in &b.stages {
+        let one = b.stages_1_thread.get(k).copied().unwrap_or(f64::NAN);
+        let ratio = if *v > 0.0 && one.is_finite() {
+            format!("{:.2}", one / v)
+        } else {
+            "-".to_string()
+        };
         say!(
-            "  {k:<14} {v:>8.3} s  {:>5.1}%",
+            "  {k:<14} {v:>6.3} s {:>6.1}% {one:>8.3} s {ratio:>8}",
             100.0 * v / total.max(1e-12)
         );
     }

@@ -42,6 +42,10 @@ pub struct ImpactBench {
     pub wall_1_thread_s_runs: Vec<f64>,
     /// Seconds per engine stage on `threads` threads (the last repeat).
     pub stages: BTreeMap<String, f64>,
+    /// Seconds per engine stage on 1 thread (the last repeat): over `stages`, each stage's
+    /// speed-up.
+    #[serde(default)]
+    pub stages_1_thread: BTreeMap<String, f64>,
     /// Impacts the surface had taken before the timed one.
     pub surface_impacts: u32,
     /// The bare kernel-sum loop over the same pairs, timed in the same run.
@@ -75,6 +79,15 @@ fn one() -> usize {
     1
 }
 
+/// Seconds per engine stage of the last impact `s` ran, by stage name.
+fn breakdown(s: &Sample) -> BTreeMap<String, f64> {
+    s.last_timers()
+        .breakdown()
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect()
+}
+
 /// The middle value (the mean of the two middle ones for an even count).
 fn median(v: &[f64]) -> f64 {
     let mut v = v.to_vec();
@@ -104,14 +117,16 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
     };
     let repeats = repeats.max(1);
     let (mut walls1, mut walls, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
-    let mut last = None;
+    let (mut last, mut last_one) = (None, None);
     for _ in 0..repeats {
         let (wall1, one) = timed(1)?;
+        let stages1 = breakdown(&one);
         let (wall, many) = if threads == 1 {
             (wall1, one)
         } else {
             timed(threads)?
         };
+        last_one = Some(stages1);
         walls1.push(wall1);
         walls.push(wall);
         ratios.push(wall1 / wall);
@@ -145,12 +160,8 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
         repeats,
         wall_s_runs: walls,
         wall_1_thread_s_runs: walls1,
-        stages: many
-            .last_timers()
-            .breakdown()
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
+        stages: breakdown(&many),
+        stages_1_thread: last_one.unwrap_or_default(),
         surface_impacts: sample.impacts_done(),
         ceiling,
     })
