@@ -65,6 +65,28 @@ fn yield_softened(jc: &JohnsonCook, eps_p: f64, rate: f64, th: f64) -> (f64, f64
     )
 }
 
+/// The zero-rate Johnson–Cook yield stress (eq. 18) at one plastic strain and temperature, with
+/// its thermal factor: what the radial return's elastic check needs, and all that depends on the
+/// particle's state alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct YieldAt {
+    /// (A + B ε_p^n)(1 − T*^m) (Pa).
+    pub sy0: f64,
+    /// 1 − T*^m.
+    pub th: f64,
+}
+
+/// `YieldAt` for plastic strain `eps_p` and temperature `t`.
+#[inline]
+pub fn yield_at(jc: &JohnsonCook, eps_p: f64, t: f64) -> YieldAt {
+    let th = thermal_softening(jc, t);
+    // The elastic check needs the yield stress alone: no derivative, so no second power.
+    YieldAt {
+        sy0: hardening(jc, eps_p) * th,
+        th,
+    }
+}
+
 /// Result of the return mapping for one particle and one step.
 #[derive(Debug, Clone, Copy)]
 pub struct Plastic {
@@ -90,10 +112,21 @@ pub fn radial_return(
     dt: f64,
     t: f64,
 ) -> Plastic {
+    radial_return_at(s_trial, shear, jc, eps_p, dt, yield_at(jc, eps_p, t))
+}
+
+/// `radial_return` with the particle's `YieldAt` given (the stress stage keeps it between steps
+/// while ε_p and T do not change).
+pub fn radial_return_at(
+    s_trial: Matrix,
+    shear: f64,
+    jc: &JohnsonCook,
+    eps_p: f64,
+    dt: f64,
+    at: YieldAt,
+) -> Plastic {
     let seq = von_mises(&s_trial);
-    let th = thermal_softening(jc, t);
-    // The elastic check needs the yield stress alone: no derivative, so no second power.
-    let sy0 = hardening(jc, eps_p) * th;
+    let YieldAt { sy0, th } = at;
     if seq <= sy0 {
         return Plastic {
             sdev: s_trial,

@@ -35,7 +35,7 @@ pub(crate) use kernel_sums::{kernel_sums, KernelSums};
 pub(crate) use pairs::rows_mut;
 pub(crate) use pairs::PairCache;
 pub(crate) use rigid::rigid;
-pub(crate) use stress::stress;
+pub(crate) use stress::{stress, YieldMemo};
 pub(crate) use time_step::stable_dt;
 
 use rayon::iter::{IndexedParallelIterator, MaxLen, MinLen};

@@ -5,15 +5,59 @@ use rayon::prelude::*;
 
 use super::{BodyConst, ParTasks};
 use crate::body::Body;
-use crate::material::{Fracture, Strength};
+use crate::material::{Fracture, JohnsonCook, Strength};
 use crate::math::Matrix;
 use crate::particles::{von_mises, Particles};
-use crate::physics;
+use crate::physics::{self, YieldAt};
+
+/// A particle's zero-rate yield stress (`physics::YieldAt`) as last computed, with the particle
+/// and the state it was computed for: a particle that stays elastic keeps ε_p and T, so its
+/// elastic check takes no power (on a surface after 30 impacts most particles have ε_p > 0 and
+/// T above room temperature, two powers each per step otherwise).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct YieldMemo {
+    id: u32,
+    eps_p: u64,
+    temp: u64,
+    at: YieldAt,
+}
+
+impl Default for YieldMemo {
+    fn default() -> Self {
+        YieldMemo {
+            id: u32::MAX,
+            eps_p: 0,
+            temp: 0,
+            at: YieldAt { sy0: 0.0, th: 0.0 },
+        }
+    }
+}
+
+impl YieldMemo {
+    /// The particle's `YieldAt`, from the memo where it was computed for this particle (by id)
+    /// at these bits of ε_p and T, else computed now and kept. Keyed on the state itself, the
+    /// memo needs no invalidation: a deletion, reordering or restored checkpoint only misses.
+    #[inline]
+    fn get(&mut self, id: u32, jc: &JohnsonCook, eps_p: f64, temp: f64) -> YieldAt {
+        let (e, t) = (eps_p.to_bits(), temp.to_bits());
+        if self.id != id || self.eps_p != e || self.temp != t {
+            *self = YieldMemo {
+                id,
+                eps_p: e,
+                temp: t,
+                at: physics::yield_at(jc, eps_p, temp),
+            };
+        }
+        self.at
+    }
+}
 
 /// Continuity (eq. 5 as ρ̇ = −ρ tr ∇v), Jaumann rate (eq. 13), radial return with Johnson–Cook
 /// yield (eq. 18), adiabatic heating with Taylor–Quinney coefficient `beta`, damage
 /// (eqs. 19–20), and the deformation gradient the hourglass stiffness compares against, from the
-/// velocity gradients `gv`; returns the plastic work of the step (J/m).
+/// velocity gradients `gv`; returns the plastic work of the step (J/m). `memo` keeps each
+/// particle's zero-rate yield stress between steps.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn stress(
     p: &mut Particles,
     bodies: &[Body],
@@ -21,7 +65,9 @@ pub(crate) fn stress(
     gv: &[Matrix],
     beta: f64,
     dt: f64,
+    memo: &mut Vec<YieldMemo>,
 ) -> f64 {
+    memo.resize(p.len(), YieldMemo::default());
     let plastic_work: f64 = p
         .rho
         .par_iter_mut()
@@ -34,10 +80,11 @@ pub(crate) fn stress(
         .zip(p.body.par_iter())
         .zip(p.mass.par_iter())
         .zip(p.rho0.par_iter())
+        .zip(memo.par_iter_mut())
         .par_tasks()
         .enumerate()
         .map(
-            |(i, (((((((((rho, s), ep), epr), temp), dmg), fdef), &b), &m), &rho0))| {
+            |(i, ((((((((((rho, s), ep), epr), temp), dmg), fdef), &b), &m), &rho0), memo))| {
                 let c = bc[b as usize];
                 if !c.deformable {
                     return 0.0;
@@ -59,7 +106,8 @@ pub(crate) fn stress(
                         0.0
                     }
                     Some(Strength::JohnsonCook(jc)) => {
-                        let r = physics::radial_return(s_trial, c.shear, jc, *ep, dt, *temp);
+                        let at = memo.get(p.id[i], jc, *ep, *temp);
+                        let r = physics::radial_return_at(s_trial, c.shear, jc, *ep, dt, at);
                         *s = r.sdev;
                         *epr = r.d_eps / dt;
                         if r.d_eps > 0.0 {

@@ -43,6 +43,8 @@ struct Scratch {
     /// Particle volumes after the stress stage: read by the forces, the contact and the density
     /// filter, which all run before ρ changes again.
     vol: Vec<f64>,
+    /// Each particle's zero-rate yield stress, kept while its ε_p and T stay (the stress stage).
+    yield_memo: Vec<stages::YieldMemo>,
     /// Accelerations of the forces.
     acc: Vec<Vector>,
     /// Contact force on each particle.
@@ -486,6 +488,7 @@ impl World {
             &self.scratch.sums.gradv,
             beta,
             dt,
+            &mut self.scratch.yield_memo,
         );
         self.work.plastic -= plastic_work;
         if stages::any_fluid(bc) {
