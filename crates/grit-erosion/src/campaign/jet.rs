@@ -106,6 +106,9 @@ pub struct JetCampaignSpec {
     pub target_width_m: f64,
     /// Target depth (m).
     pub target_depth_m: f64,
+    /// Hold the target's bottom fixed (default) or leave it free ([`JetParams::fixed_bottom`]).
+    #[serde(skip_serializing_if = "crate::jet::is_true")]
+    pub fixed_bottom: bool,
     /// Grain diameter (m).
     pub grain_diameter_m: f64,
     /// Grain density (kg/m³).
@@ -141,6 +144,7 @@ impl Default for JetCampaignSpec {
             standoff_m: p.standoff_m,
             target_width_m: p.target_width_m,
             target_depth_m: p.target_depth_m,
+            fixed_bottom: p.fixed_bottom,
             grain_diameter_m: p.grain_diameter_m,
             grain_density_kg_m3: p.grain_density_kg_m3,
             grain_speed_ratio: p.grain_speed_ratio,
@@ -379,6 +383,7 @@ impl JetCampaignSpec {
                     standoff_m: self.standoff_m,
                     target_width_m: self.target_width_m,
                     target_depth_m: self.target_depth_m,
+                    fixed_bottom: self.fixed_bottom,
                     grain_diameter_m: self.grain_diameter_m,
                     grain_density_kg_m3: self.grain_density_kg_m3,
                     grain_speed_ratio: self.grain_speed_ratio,

@@ -48,6 +48,11 @@ pub struct JetParams {
     pub target_width_m: f64,
     /// Target depth (m).
     pub target_depth_m: f64,
+    /// Hold the target's bottom layers fixed, as its sides (the default: the target is a window
+    /// into a thick plate); false leaves the bottom free, as the paper does
+    /// (docs/jet.md#the-scene). Written out only when false, so default scenes keep their bytes.
+    #[serde(skip_serializing_if = "is_true")]
+    pub fixed_bottom: bool,
     /// Grain diameter d (m; the paper's 0.2 mm garnet).
     pub grain_diameter_m: f64,
     /// Grain density (kg/m³; garnet 4120).
@@ -65,6 +70,11 @@ pub struct JetParams {
     pub penalty: PenaltyParams,
 }
 
+/// Serde's test for a field written out only when false.
+pub(crate) fn is_true(b: &bool) -> bool {
+    *b
+}
+
 impl Default for JetParams {
     fn default() -> Self {
         JetParams {
@@ -79,6 +89,7 @@ impl Default for JetParams {
             standoff_m: 2e-3,
             target_width_m: 6e-3,
             target_depth_m: 2e-3,
+            fixed_bottom: true,
             grain_diameter_m: 0.2e-3,
             grain_density_kg_m3: 4120.0,
             grain_speed_ratio: 1.0,

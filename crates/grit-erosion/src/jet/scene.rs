@@ -116,7 +116,10 @@ pub fn build(params: &JetParams) -> Result<(World, Layout), InputError> {
         0.5 * params.target_width_m - fixed,
         -params.target_depth_m + fixed,
     );
-    world.set_kinematic(target, Motion::Fixed, |x| x.x.abs() > inner || x.y < floor)?;
+    let bottom = params.fixed_bottom;
+    world.set_kinematic(target, Motion::Fixed, |x| {
+        x.x.abs() > inner || (bottom && x.y < floor)
+    })?;
     let water = world.add_fluid("water", jet_water(), &[], &[], &[], Vector::zeros())?;
     debug_assert_eq!((target, water), (layout.target_body, layout.fluid_body));
     world.add_outflow(water, layout.box_min_m, layout.box_max_m)?;
@@ -142,4 +145,43 @@ pub fn build(params: &JetParams) -> Result<(World, Layout), InputError> {
         world.set_grain_outflow(layout.box_min_m, layout.box_max_m)?;
     }
     Ok((world, layout))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use grit_sph::particles::KINEMATIC;
+
+    /// The target's fixed particles under the middle third of its width, where only a fixed
+    /// bottom holds any.
+    fn fixed_under_the_jet(params: &JetParams) -> usize {
+        let (world, layout) = build(params).unwrap();
+        let p = world.particles();
+        (0..p.len())
+            .filter(|&i| {
+                p.body[i] as usize == layout.target_body
+                    && p.flags[i] & KINEMATIC != 0
+                    && p.pos[i].x.abs() < params.target_width_m / 6.0
+            })
+            .count()
+    }
+
+    #[test]
+    fn the_bottom_is_fixed_unless_the_scene_frees_it_and_a_default_scene_keeps_its_bytes() {
+        let fixed = JetParams {
+            spacing_m: 1e-4,
+            ..JetParams::default()
+        };
+        let free = JetParams {
+            fixed_bottom: false,
+            ..fixed.clone()
+        };
+        // Three layers under the middle third: 20 columns of 100 µm in 2 mm.
+        assert_eq!(fixed_under_the_jet(&fixed), 3 * 20);
+        assert_eq!(fixed_under_the_jet(&free), 0);
+        let text = serde_json::to_string(&fixed).unwrap();
+        assert!(!text.contains("fixed_bottom"), "{text}");
+        let back: JetParams = serde_json::from_str(&serde_json::to_string(&free).unwrap()).unwrap();
+        assert_eq!(back, free);
+    }
 }
