@@ -120,13 +120,12 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
     let (mut last, mut last_one) = (None, None);
     for _ in 0..repeats {
         let (wall1, one) = timed(1)?;
-        let stages1 = breakdown(&one);
+        last_one = Some(breakdown(&one));
         let (wall, many) = if threads == 1 {
             (wall1, one)
         } else {
             timed(threads)?
         };
-        last_one = Some(stages1);
         walls1.push(wall1);
         walls.push(wall);
         ratios.push(wall1 / wall);

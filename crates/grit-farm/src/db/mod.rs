@@ -160,7 +160,6 @@ async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool>
     Ok(clean)
 }
 
-/// Parses a uuid the store wrote.
 /// A campaign's stored records, each row (cell index, sample index, …) taken by `take`, grouped
 /// per cell (`cells` of them) and per sample in the rows' order; rows of cells beyond `cells` are
 /// left out.
@@ -182,6 +181,7 @@ fn per_cell_and_sample<T>(
     Ok(per_cell)
 }
 
+/// Parses a uuid the store wrote.
 fn parse_uuid(s: &str) -> Result<Uuid> {
     Uuid::from_str(s).map_err(|e| Error::Internal(format!("stored id {s}: {e}")))
 }

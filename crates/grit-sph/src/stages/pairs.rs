@@ -1,8 +1,8 @@
 //! The same-body pairs of a step, each evaluated once (`neighbours::HalfIndex`): the separation,
 //! the kernel W and dW/dr (seed eq. 4) of pair (i, j), i < j, seen from i. Particle j reads the
 //! same values turned round: x_ji = −x_ij exactly (and so e_ji = −e_ij where the forces take
-//! it again), and W, dW/dr and r do not depend on the side, so each particle's sums get bitwise the terms they would from its own
-//! evaluation of the pair.
+//! it again), and W, dW/dr and r do not depend on the side, so each particle's sums get bitwise
+//! the terms they would from its own evaluation of the pair.
 
 use rayon::prelude::*;
 

@@ -17,6 +17,7 @@ pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::body::Body;
@@ -27,7 +28,7 @@ use crate::math::Vector;
 use crate::neighbours::{self, WorldLists};
 use crate::particles::Particles;
 use crate::stages::{
-    self, Blowup, BodyConst, KernelSums, PairCache, PairForce, PassedThrough, SphView,
+    self, Blowup, BodyConst, KernelSums, PairCache, PairForce, ParTasks, PassedThrough, SphView,
 };
 use crate::timers::{Stage, Timers};
 
@@ -406,8 +407,6 @@ impl World {
             self.filter_density_with(bc);
         }
         // Deleted: solids at D ≥ 1, free fluid particles outside their fluid's density range.
-        use crate::stages::ParTasks;
-        use rayon::prelude::*;
         let p = &self.particles;
         let failed: Vec<bool> = (0..p.len())
             .into_par_iter()
