@@ -154,11 +154,13 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
     let mut failure = None;
     while !run.finished() {
         let ran = pool.install(|| {
-            run.run_next_slice_observed(
-                &|| false,
-                Some(&mut |w: &grit_sph::World| bar.set_position((w.time() * 1e6) as u64)),
-            )
-            .map(|_| ())
+            grit_sph::polling::run_polling(|| {
+                run.run_next_slice_observed(
+                    &|| false,
+                    Some(&mut |w: &grit_sph::World| bar.set_position((w.time() * 1e6) as u64)),
+                )
+                .map(|_| ())
+            })
         });
         if let Err(e) = ran {
             failure = Some(e);

@@ -259,7 +259,12 @@ impl Runner {
             let mut handle = tokio::task::spawn_blocking(move || {
                 let cancel = || stop.is_set() || lost_flag.load(Ordering::SeqCst);
                 let result = match &pool {
-                    Some(p) => p.install(|| sample.run_next_cancellable(&cancel).cloned()),
+                    // The pool is this worker's own: one world steps on it at a time.
+                    Some(p) => p.install(|| {
+                        grit_sph::polling::run_polling(|| {
+                            sample.run_next_cancellable(&cancel).cloned()
+                        })
+                    }),
                     None => sample.run_next_cancellable(&cancel).cloned(),
                 };
                 (sample, result)

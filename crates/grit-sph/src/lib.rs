@@ -24,6 +24,7 @@ pub mod math;
 pub mod neighbours;
 pub mod particles;
 pub mod physics;
+pub mod polling;
 mod stages;
 pub mod timers;
 pub mod vtk;

@@ -74,7 +74,8 @@ impl Runner {
                         .map(|s| s.cloned())
                 };
                 let result = match &pool {
-                    Some(p) => p.install(step),
+                    // The pool is this worker's own: one world steps on it at a time.
+                    Some(p) => p.install(|| grit_sph::polling::run_polling(step)),
                     None => step(),
                 };
                 // Serialising the world takes milliseconds: here, not on the async threads.
