@@ -208,24 +208,33 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
         say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         say!(
-            "{:>9} {:>12} {:>10} {:>10} {:>8} {:>7}",
+            "{:>9} {:>12} {:>10} {:>10} {:>8} {:>7} {:>5} {:>11}",
             "t (ms)",
             "loss (kg/m)",
             "Cd (µm)",
             "Cw (µm)",
             "eps_p",
-            "grains"
+            "grains",
+            "hits",
+            "hit v_n m/s"
         );
         for s in run.slices() {
             let c = &s.sample;
+            // The grains that first touched the target in the slice, and their mean approach
+            // speed along the contact normal.
+            let (hits, v_n) = s.grain_hits.map_or((0, "-".to_string()), |h| {
+                (h.count, format!("{:.0}", h.normal_speed_m_s.mean))
+            });
             say!(
-                "{:>9.4} {:>12.4e} {:>10.1} {:>10.1} {:>8.3} {:>7}",
+                "{:>9.4} {:>12.4e} {:>10.1} {:>10.1} {:>8.3} {:>7} {:>5} {:>11}",
                 c.t_s * 1e3,
                 c.mass_loss_kg_m,
                 c.crater_depth_m * 1e6,
                 c.crater_width_m * 1e6,
                 c.max_plastic_strain,
-                s.grains
+                s.grains,
+                hits,
+                v_n
             );
         }
         say!("{:.1} s wall", out.wall_s);

@@ -132,6 +132,46 @@ fn grains_in_the_water_and_on_the_target_conserve_momentum() {
 }
 
 #[test]
+fn each_grain_logs_its_first_touch_of_the_target_once_with_its_speed_then() {
+    let mut w = water_on_copper(100.0, true);
+    let (mut hits, mut touching_steps) = (Vec::new(), 0);
+    for _ in 0..600 {
+        let before: Vec<Vector> = w
+            .abrasives()
+            .unwrap()
+            .dem
+            .grains
+            .iter()
+            .map(|g| g.vel)
+            .collect();
+        w.step().unwrap();
+        let new = w.take_grain_hits();
+        for h in &new {
+            // The logged speed is a grain's speed at the start of the step it touched in.
+            assert!(
+                before.iter().any(|v| v.norm() == h.speed_m_s),
+                "{h:?} is no grain's speed at the step's start"
+            );
+            assert!(
+                h.normal_speed_m_s > 0.0 && h.normal_speed_m_s <= h.speed_m_s,
+                "{h:?}"
+            );
+        }
+        hits.extend(new);
+        touching_steps += usize::from(w.contact_forces().iter().any(|f| f.norm() > 0.0));
+    }
+    assert_eq!(hits.len(), 2, "one first touch per grain: {hits:?}");
+    assert!(
+        touching_steps > 2,
+        "the grains stayed in contact for {touching_steps} steps"
+    );
+    assert!(w.abrasives().unwrap().dem.grains.iter().all(|g| g.touched));
+    // An untouched grain keeps the bytes it had before the flag existed.
+    let fresh = serde_json::to_string(&Grain::sphere(Vector::zeros(), 1e-4, 4120.0)).unwrap();
+    assert!(!fresh.contains("touched"), "{fresh}");
+}
+
+#[test]
 fn water_grains_and_target_give_the_same_bits_on_one_and_two_threads() {
     let one = stepped_on(1, 300, || water_on_copper(100.0, true));
     let two = stepped_on(2, 300, || water_on_copper(100.0, true));

@@ -689,6 +689,7 @@ mod tests {
             water_deleted_kg_m: 0.0,
             water_fed_kg_m: 0.0,
             wall_s: 0.5,
+            grain_hits: None,
         }
     }
 

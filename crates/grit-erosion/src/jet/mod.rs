@@ -13,9 +13,11 @@ mod scene;
 
 use grit_sph::crater::{self, CraterOptions, CraterSample};
 use grit_sph::dem::DemParams;
+use grit_sph::world::GrainHit;
 use grit_sph::{InputError, PenaltyParams, SimError, Timers, World};
 use serde::{Deserialize, Serialize};
 
+use crate::aggregate::{stats, Stats};
 use crate::campaign::MaterialSpec;
 pub use feed::{grain_spacing_m, Feed};
 pub use scene::{Layout, FIXED_SIDE_LAYERS, WATER_DENSITY_DIFFUSION, WATER_DENSITY_RANGE};
@@ -265,6 +267,39 @@ pub struct JetSlice {
     pub water_fed_kg_m: f64,
     /// Wall-clock seconds the slice took.
     pub wall_s: f64,
+    /// The grains that first touched the target in the slice and how fast they came; absent
+    /// when none did (and from runs stored before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grain_hits: Option<GrainHits>,
+}
+
+/// The grains' first touches of the target in one slice (`World::take_grain_hits`): how fast
+/// the jet delivers its grains, beside the AWJ paper's single grain in a jet
+/// (docs/jet.md#how-fast-the-grains-arrive).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GrainHits {
+    /// Grains that touched the target for the first time.
+    pub count: usize,
+    /// Their speed |v| at the touch (m/s).
+    pub speed_m_s: Stats,
+    /// Their approach speed along the normal of the first contact (m/s).
+    pub normal_speed_m_s: Stats,
+    /// The fastest of them, |v| (m/s): a grain faster than the jet has been thrown by a contact.
+    pub fastest_m_s: f64,
+}
+
+impl GrainHits {
+    /// The statistics of `hits`; `None` when there are none.
+    pub fn of(hits: &[GrainHit]) -> Option<GrainHits> {
+        let speeds: Vec<f64> = hits.iter().map(|h| h.speed_m_s).collect();
+        let normal: Vec<f64> = hits.iter().map(|h| h.normal_speed_m_s).collect();
+        Some(GrainHits {
+            count: hits.len(),
+            speed_m_s: stats(&speeds)?,
+            normal_speed_m_s: stats(&normal)?,
+            fastest_m_s: speeds.iter().copied().fold(0.0, f64::max),
+        })
+    }
 }
 
 /// Why a jet run could not go on.
@@ -415,6 +450,8 @@ impl JetRun {
         let t0 = std::time::Instant::now();
         let steps0 = self.world.steps();
         self.world.timers_mut().reset();
+        // A slice abandoned by `cancel` may have left touches of its own in the log.
+        self.world.take_grain_hits();
         while self.world.time() < t_end {
             if cancel() {
                 return Ok(None);
@@ -426,10 +463,12 @@ impl JetRun {
                 f(&self.world);
             }
         }
+        let hits = self.world.take_grain_hits();
         let slice = self.measure(
             k + 1,
             self.world.steps() - steps0,
             t0.elapsed().as_secs_f64(),
+            &hits,
         )?;
         self.slices.push(slice);
         Ok(self.slices.last())
@@ -438,7 +477,13 @@ impl JetRun {
     /// The crater and state now, as slice `slice`. The mass loss is the target's deleted
     /// particles (D ≥ 1) and the fragments that left the scene; the crater is measured on the
     /// target that still hangs together with its fixed particles.
-    fn measure(&self, slice: u32, steps: u64, wall_s: f64) -> Result<JetSlice, JetError> {
+    fn measure(
+        &self,
+        slice: u32,
+        steps: u64,
+        wall_s: f64,
+        hits: &[GrainHit],
+    ) -> Result<JetSlice, JetError> {
         let w = &self.world;
         let opts = CraterOptions::for_spacing(self.params.spacing_m);
         let target = self.layout.target_body;
@@ -470,6 +515,7 @@ impl JetRun {
             water_deleted_kg_m: w.bodies()[self.layout.fluid_body].removed_mass_kg_m,
             water_fed_kg_m: w.inflows().iter().map(|i| i.mass_kg_m).sum(),
             wall_s,
+            grain_hits: GrainHits::of(hits),
         })
     }
 

@@ -138,6 +138,7 @@ mod tests {
                 water_deleted_kg_m: 0.0,
                 water_fed_kg_m: 0.0,
                 wall_s: 0.1,
+                grain_hits: None,
             })
             .collect();
         JetRunRecord {

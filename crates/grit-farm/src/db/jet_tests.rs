@@ -36,6 +36,7 @@ fn slice(k: u32) -> JetSlice {
         water_deleted_kg_m: 0.0,
         water_fed_kg_m: 0.0,
         wall_s: 0.1,
+        grain_hits: None,
     }
 }
 

@@ -41,6 +41,11 @@ pub struct Grain {
     pub mass_kg: f64,
     /// Moment of inertia about the centre (kg·m²).
     pub inertia_kg_m2: f64,
+    /// Whether the grain has touched a deformable particle yet (the penalty contact of the AWJ
+    /// paper eqs. 12–14); its first touch is logged as a [`crate::world::GrainHit`]. Absent from
+    /// the JSON while false, so grains stored before it keep their bytes.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub touched: bool,
 }
 
 impl Grain {
@@ -56,6 +61,7 @@ impl Grain {
             radius_m: r,
             mass_kg: mass,
             inertia_kg_m2: 0.4 * mass * r * r,
+            touched: false,
         }
     }
 

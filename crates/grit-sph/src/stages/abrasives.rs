@@ -121,7 +121,8 @@ pub(crate) fn coupling_forces(
 /// The penalty contact (eqs. 12–14) between every grain and the deformable particles within
 /// `d_ini` of its surface: the force on each particle into `contact_force`, the reaction and
 /// its torque about the grain's centre into `loads`. `d_ini` is the particle spacing and `dt`
-/// the SPH step.
+/// the SPH step. Returns the grains not yet `touched` that touch now, each with its approach
+/// speed along the normal of its first contact (in particle order).
 pub(crate) fn penalty(
     p: &Particles,
     bc: &[BodyConst],
@@ -130,10 +131,11 @@ pub(crate) fn penalty(
     dt: f64,
     contact_force: &mut [Vector],
     loads: &mut GrainLoads,
-) {
+) -> Vec<(usize, f64)> {
     let grains = &ab.dem.grains;
+    let mut touches = Vec::new();
     if grains.is_empty() {
-        return;
+        return touches;
     }
     // The deformable particles sorted on x; each grain scans its window.
     let mut order: Vec<usize> = (0..p.len())
@@ -168,11 +170,16 @@ pub(crate) fn penalty(
             ) else {
                 continue;
             };
+            if !grain.touched && touches.last().is_none_or(|&(t, _)| t != g) {
+                let n = (c.point - grain.pos) / grain.radius_m;
+                touches.push((g, (grain.vel - p.vel[i]).dot(&n)));
+            }
             contact_force[i] += c.force_on_particle;
             loads.force[g] -= c.force_on_particle;
             loads.torque[g] += cross(c.point - grain.pos, -c.force_on_particle);
         }
     }
+    touches
 }
 
 /// Advances the grains by the SPH step `dt` in n = ⌈dt / Δt_dem⌉ equal DEM sub-steps

@@ -81,6 +81,23 @@ pub struct Abrasives {
     /// DEM sub-steps taken in the last SPH step.
     #[serde(skip)]
     pub substeps: u32,
+    /// First touches of the target since the log was last taken (`World::take_grain_hits`).
+    #[serde(skip)]
+    pub hits: Vec<GrainHit>,
+}
+
+/// A grain's first touch of a deformable particle (the penalty contact of the AWJ paper
+/// eqs. 12–14): how fast the jet delivered it, to set beside the paper's single grain in a jet
+/// (166 m/s at R_c = 2 d; docs/jet.md#how-fast-the-grains-arrive).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GrainHit {
+    /// Time of the step in which the contact began (s).
+    pub t_s: f64,
+    /// The grain's speed |v| at the start of that step (m/s).
+    pub speed_m_s: f64,
+    /// Its approach speed along the contact normal, (v_grain − v_particle)·n with n from the
+    /// grain's centre to the particle (m/s).
+    pub normal_speed_m_s: f64,
 }
 
 impl Abrasives {
@@ -100,6 +117,7 @@ impl Abrasives {
             outflow: None,
             added: 0,
             substeps: 0,
+            hits: Vec::new(),
         }
     }
 
@@ -160,6 +178,15 @@ impl World {
     /// The grains and their coupling, if the world has any.
     pub fn abrasives(&self) -> Option<&Abrasives> {
         self.abrasives.as_ref()
+    }
+
+    /// The grains' first touches of the target since the last call, in the order they happened
+    /// (grain order within a step); empty without abrasives.
+    pub fn take_grain_hits(&mut self) -> Vec<GrainHit> {
+        self.abrasives
+            .as_mut()
+            .map(|ab| std::mem::take(&mut ab.hits))
+            .unwrap_or_default()
     }
 
     fn abrasives_mut(&mut self, field: &str) -> Result<&mut Abrasives, InputError> {

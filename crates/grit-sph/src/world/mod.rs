@@ -12,7 +12,7 @@ mod flow;
 mod settings;
 
 pub use crate::stages::{CeilingPass, WallLoad, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
-pub use abrasives::{plane_mass, Abrasives, GrainOutflow, PenaltyParams};
+pub use abrasives::{plane_mass, Abrasives, GrainHit, GrainOutflow, PenaltyParams};
 pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
@@ -601,7 +601,16 @@ impl World {
         }
         let d_ini = self.settings.spacing_m;
         let cf = &mut sc.contact_force;
-        stages::penalty(&self.particles, bc, ab, d_ini, dt, cf, &mut sc.loads);
+        let touches = stages::penalty(&self.particles, bc, ab, d_ini, dt, cf, &mut sc.loads);
+        for (g, normal_speed_m_s) in touches {
+            let grain = &mut ab.dem.grains[g];
+            grain.touched = true;
+            ab.hits.push(GrainHit {
+                t_s: self.time,
+                speed_m_s: grain.vel.norm(),
+                normal_speed_m_s,
+            });
+        }
         ab.substeps = stages::advance(ab, dt, &sc.loads).map_err(err)?;
         Ok(())
     }
