@@ -16,14 +16,18 @@ use std::cell::{Cell, RefCell};
 use grit_erosion::jet::{JetParams, JetRun};
 use grit_sph::{Vector, World};
 
-fn arg<T: std::str::FromStr>(k: usize, default: T) -> T {
-    std::env::args()
-        .nth(k)
-        .map_or(default, |s| s.parse().ok().expect("a number"))
+/// Argument `k` (`name`), or `default` when it is not given.
+fn arg<T: std::str::FromStr>(k: usize, name: &str, default: T) -> Result<T, String> {
+    std::env::args().nth(k).map_or(Ok(default), |s| {
+        s.parse()
+            .map_err(|_| format!("{name}: not a number: {s:?}"))
+    })
 }
 
-fn main() {
-    let (seed, ratio, spacing) = (arg(1, 1u64), arg(2, 1.0), arg(3, 1e-4));
+fn main() -> Result<(), String> {
+    let seed = arg(1, "SEED", 1u64)?;
+    let ratio = arg(2, "RELEASE_RATIO", 1.0)?;
+    let spacing = arg(3, "SPACING_M", 1e-4)?;
     let params = JetParams {
         time_ms: 0.2,
         slice_ms: 0.05,
@@ -31,7 +35,8 @@ fn main() {
         spacing_m: spacing,
         ..JetParams::default()
     };
-    let mut run = JetRun::new(params, seed).expect("the default scene");
+    params.validate().map_err(|e| e.to_string())?;
+    let mut run = JetRun::new(params, seed).map_err(|e| e.to_string())?;
     // Per grain of the last step: its position and whether it touched the target.
     let last: RefCell<Vec<(Vector, bool)>> = RefCell::new(Vec::new());
     // Per contact start in the slice: the grain's speed.
@@ -69,8 +74,8 @@ fn main() {
         in_contact.set(0);
         let s = run
             .run_next_slice_observed(&|| false, Some(&mut watch))
-            .expect("the slice runs")
-            .expect("not cancelled");
+            .map_err(|e| e.to_string())?
+            .ok_or("the slice was cancelled")?;
         let v = starts.borrow();
         let n = v.len().max(1) as f64;
         println!(
@@ -84,4 +89,5 @@ fn main() {
             s.sample.mass_loss_kg_m * 1e3
         );
     }
+    Ok(())
 }
