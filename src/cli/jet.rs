@@ -153,14 +153,12 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
     let t0 = Instant::now();
     let mut failure = None;
     while !run.finished() {
-        let ran = pool.install(|| {
-            grit_sph::polling::run_polling(|| {
-                run.run_next_slice_observed(
-                    &|| false,
-                    Some(&mut |w: &grit_sph::World| bar.set_position((w.time() * 1e6) as u64)),
-                )
-                .map(|_| ())
-            })
+        let ran = grit_sph::polling::install_polling(&pool, || {
+            run.run_next_slice_observed(
+                &|| false,
+                Some(&mut |w: &grit_sph::World| bar.set_position((w.time() * 1e6) as u64)),
+            )
+            .map(|_| ())
         });
         if let Err(e) = ran {
             failure = Some(e);

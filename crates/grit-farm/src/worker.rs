@@ -260,10 +260,8 @@ impl Runner {
                 let cancel = || stop.is_set() || lost_flag.load(Ordering::SeqCst);
                 let result = match &pool {
                     // The pool is this worker's own: one world steps on it at a time.
-                    Some(p) => p.install(|| {
-                        grit_sph::polling::run_polling(|| {
-                            sample.run_next_cancellable(&cancel).cloned()
-                        })
+                    Some(p) => grit_sph::polling::install_polling(p, || {
+                        sample.run_next_cancellable(&cancel).cloned()
                     }),
                     None => sample.run_next_cancellable(&cancel).cloned(),
                 };

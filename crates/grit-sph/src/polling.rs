@@ -7,14 +7,19 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Runs `f` while the other workers of the current rayon pool poll for its tasks instead of
-/// falling asleep between them (docs/performance.md, "The other worker polls through the run").
+/// Runs `f` on `pool` while the pool's other workers poll for its tasks instead of falling
+/// asleep between them (docs/performance.md, "The other worker polls through the run").
 ///
-/// Only for a caller that steps one world at a time on its pool, as `grit sample`, `grit jet`,
-/// the bench and a farm worker with a pool of its own do. Two such runs on one pool at once,
-/// each from a worker of it (a sweep's samples in parallel), could each end up polling inside
-/// the other's task and wait for each other for ever.
-pub fn run_polling<R>(f: impl FnOnce() -> R) -> R {
+/// Only for a pool that is this run's own, stepping one world at a time, as in `grit sample`,
+/// `grit jet`, the bench and a farm worker with a pool of its own: two such runs on one pool at
+/// once, each from a worker of it (a sweep's samples in parallel), could each end up polling
+/// inside the other's task and wait for each other for ever.
+pub fn install_polling<R: Send>(pool: &rayon::ThreadPool, f: impl FnOnce() -> R + Send) -> R {
+    pool.install(|| run_polling(f))
+}
+
+/// `install_polling` on the current pool (the global one outside any).
+fn run_polling<R>(f: impl FnOnce() -> R) -> R {
     let others = rayon::current_num_threads().saturating_sub(1);
     if others == 0 {
         return f();
@@ -71,7 +76,7 @@ mod tests {
     fn a_polled_run_does_its_loops_and_returns_on_any_thread_count() {
         for threads in [1, 2, 3] {
             let total =
-                pool(threads).install(|| run_polling(|| (0..50).map(|_| sum(10_000)).sum::<u64>()));
+                install_polling(&pool(threads), || (0..50).map(|_| sum(10_000)).sum::<u64>());
             assert_eq!(total, 50 * (10_000 * 9_999 / 2), "{threads} threads");
         }
         // Outside any pool the pollers run on the global pool's workers.
@@ -80,7 +85,7 @@ mod tests {
 
     #[test]
     fn a_panicking_run_still_returns_its_panic() {
-        let r = pool(2).install(|| std::panic::catch_unwind(|| run_polling(|| panic!("boom"))));
+        let r = std::panic::catch_unwind(|| install_polling(&pool(2), || panic!("boom")));
         assert!(r.is_err());
     }
 }

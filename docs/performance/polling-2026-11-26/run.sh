@@ -1,7 +1,7 @@
 #!/bin/bash
 # Three rounds of `grit bench impact --repeat 5 --json` and of the same on the surface after 30
 # impacts (`--after 30 --repeat 3`), alternating the build before (`1f84742`) and the one whose
-# runs keep the pool's other worker polling (`poll`, `grit_sph::polling::run_polling`); expects
+# runs keep the pool's other worker polling (`poll`, `grit_sph::polling`); expects
 # both as /work/bins/grit-NAME. Medians:
 #   python3 docs/performance/medians.py docs/performance/polling-2026-11-26 1f84742 poll
 #   python3 docs/performance/medians.py docs/performance/polling-2026-11-26 after30-1f84742 after30-poll

@@ -125,13 +125,11 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             Some(snap) if snap.wants(k) => Some(PeakTracker::new(&s.next_grain()?)),
             _ => None,
         };
-        let ran = pool.install(|| {
-            grit_sph::polling::run_polling(|| match tracker.as_mut() {
-                Some(t) => s
-                    .run_next_observed(&|| false, Some(&mut |w| t.observe(w)))
-                    .map(|_| ()),
-                None => s.run_next().map(|_| ()),
-            })
+        let ran = grit_sph::polling::install_polling(&pool, || match tracker.as_mut() {
+            Some(t) => s
+                .run_next_observed(&|| false, Some(&mut |w| t.observe(w)))
+                .map(|_| ()),
+            None => s.run_next().map(|_| ()),
         });
         if let Err(e) = ran {
             // Keep what the finished impacts found: they are written below, then the error.

@@ -112,7 +112,7 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
             .map_err(|e| SampleError::Checkpoint(format!("thread pool: {e}")))?;
         let mut s = sample.clone();
         let t0 = Instant::now();
-        pool.install(|| grit_sph::polling::run_polling(|| s.run_next().map(|_| ())))?;
+        grit_sph::polling::install_polling(&pool, || s.run_next().map(|_| ()))?;
         Ok((t0.elapsed().as_secs_f64(), s))
     };
     let repeats = repeats.max(1);

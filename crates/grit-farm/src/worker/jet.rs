@@ -75,7 +75,7 @@ impl Runner {
                 };
                 let result = match &pool {
                     // The pool is this worker's own: one world steps on it at a time.
-                    Some(p) => p.install(|| grit_sph::polling::run_polling(step)),
+                    Some(p) => grit_sph::polling::install_polling(p, step),
                     None => step(),
                 };
                 // Serialising the world takes milliseconds: here, not on the async threads.
