@@ -13,7 +13,7 @@ use crate::impact::{
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
-pub const CHECKPOINT_VERSION: u32 = 4;
+pub const CHECKPOINT_VERSION: u32 = 5;
 
 /// One impact of a sample as reported to the farm and printed by `grit sample`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -69,6 +69,7 @@ struct Checkpoint {
     /// (not self-describing) cannot do.
     params_json: String,
     seed: u64,
+    #[serde(deserialize_with = "grit_sph::particles::deserialize_filled")]
     surface: Particles,
     records: Vec<ImpactRecord>,
 }

@@ -321,5 +321,13 @@ pub fn artificial_viscosity_acceleration(m_b: f64, pi_ab: f64, grad: Vector) -> 
     -grad * (m_b * pi_ab)
 }
 
+/// Particle a's share of the heat its artificial viscosity dissipates with b (J/kg/s),
+/// ½ m_b Π_ab v_ab·∇_a W_ab (Monaghan 1992, eq. 2.27): each end takes half of the work the
+/// pair's viscous forces take from the motion.
+#[inline]
+pub fn viscous_heating(m_b: f64, pi_ab: f64, v_ab: Vector, grad: Vector) -> f64 {
+    0.5 * m_b * pi_ab * v_ab.dot(&grad)
+}
+
 #[cfg(test)]
 mod tests;

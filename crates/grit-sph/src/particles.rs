@@ -36,6 +36,11 @@ pub struct Particles {
     pub eps_p_rate: Vec<f64>,
     /// Temperature (K).
     pub temp: Vec<f64>,
+    /// Specific internal energy above the reference state (J/kg), integrated for the bodies
+    /// whose pressure law reads it (a Mie–Grüneisen EOS, AWJ paper eq. 24); 0 elsewhere. Written
+    /// as an empty array while all zero, and read back as zeros then ([`deserialize_filled`]).
+    #[serde(default, serialize_with = "zeros_as_empty")]
+    pub energy: Vec<f64>,
     /// Johnson–Cook damage D (eq. 19).
     pub damage: Vec<f64>,
     /// Deformation gradient since the reference configuration (hourglass stiffness, eq. 16).
@@ -83,6 +88,7 @@ impl Particles {
             eps_p: gather(&self.eps_p, order),
             eps_p_rate: gather(&self.eps_p_rate, order),
             temp: gather(&self.temp, order),
+            energy: gather(&self.energy, order),
             damage: gather(&self.damage, order),
             def_grad: gather(&self.def_grad, order),
             x_ref: gather(&self.x_ref, order),
@@ -109,6 +115,7 @@ impl Particles {
         self.eps_p.append(&mut other.eps_p);
         self.eps_p_rate.append(&mut other.eps_p_rate);
         self.temp.append(&mut other.temp);
+        self.energy.append(&mut other.energy);
         self.damage.append(&mut other.damage);
         self.def_grad.append(&mut other.def_grad);
         self.x_ref.append(&mut other.x_ref);
@@ -130,6 +137,7 @@ impl Particles {
             self.eps_p.len(),
             self.eps_p_rate.len(),
             self.temp.len(),
+            self.energy.len(),
             self.damage.len(),
             self.def_grad.len(),
             self.x_ref.len(),
@@ -151,6 +159,27 @@ pub fn von_mises(s: &Matrix) -> f64 {
 pub fn dev_contract(s: &Matrix) -> f64 {
     let szz = -(s[(0, 0)] + s[(1, 1)]);
     s[(0, 0)] * s[(0, 0)] + s[(1, 1)] * s[(1, 1)] + szz * szz + 2.0 * s[(0, 1)] * s[(0, 1)]
+}
+
+/// An all-zero array as an empty one: states of bodies without an energy equation keep their
+/// size (and a field is never skipped, which a positional format such as postcard cannot do).
+fn zeros_as_empty<S: serde::Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+    if v.iter().all(|&x| x == 0.0) {
+        s.collect_seq(std::iter::empty::<f64>())
+    } else {
+        s.collect_seq(v)
+    }
+}
+
+/// Reads particles whose JSON may leave out the all-zero `energy` (every state written before
+/// it existed, and every state of bodies without an energy equation): the missing array reads
+/// as zeros, one per particle. Use as `#[serde(deserialize_with = ...)]` on a `Particles` field.
+pub fn deserialize_filled<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Particles, D::Error> {
+    let mut p = Particles::deserialize(d)?;
+    if p.energy.is_empty() {
+        p.energy = vec![0.0; p.id.len()];
+    }
+    Ok(p)
 }
 
 /// The indices i with `keep[i]`, in order: the gather order that keeps those particles.

@@ -340,7 +340,7 @@ struct Checkpoint {
 }
 
 /// Version of the checkpoint layout; a build reads only its own.
-const CHECKPOINT_VERSION: u32 = 2;
+const CHECKPOINT_VERSION: u32 = 3;
 
 impl JetRun {
     /// A fresh run of `params` whose grains are placed from `seed`.

@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{HalfPair, PairCache, APART, USED};
+use super::pairs::{pairs_of, PairCache};
 use super::{BodyConst, ParTasks, SphView};
 use crate::eos::MieGruneisen;
 use crate::fluid::{self, ArtificialViscosity, Fluid};
@@ -51,8 +51,9 @@ impl FluidConst {
         }
     }
 
-    /// `Fluid::pressure` (eq. 24 at ρ = ρ̄/ε, cut at the cavitation pressure) with e = 0 and
-    /// the density capped below the singular compression.
+    /// `Fluid::pressure` (eq. 24 at ρ = ρ̄/ε, cut at the cavitation pressure) on its cold curve,
+    /// e = 0 (docs/jet.md#energy: the water's energy equation was measured and not adopted),
+    /// with the density capped below the singular compression.
     #[inline]
     pub fn pressure(&self, rho_bar: f64, porosity: f64) -> f64 {
         self.eos
@@ -84,22 +85,6 @@ impl FluidConst {
     pub fn sound_speed(&self, rho_bar: f64, porosity: f64) -> f64 {
         self.eos.sound_speed((rho_bar / porosity).min(self.rho_cap))
     }
-}
-
-/// The used same-body pairs of particle `i` this step, seen from `i`: (j, pair).
-fn pairs_of<'a>(
-    s: SphView<'a>,
-    hi: &'a HalfIndex,
-    cache: &'a PairCache,
-    i: usize,
-) -> impl Iterator<Item = (usize, HalfPair)> + 'a {
-    let nl = s.nl;
-    let ids = &hi.id[nl.start[i] as usize..];
-    nl.of(i).iter().zip(ids).filter_map(move |(&j, &id)| {
-        let bits = cache.flags[id as usize];
-        (bits & (USED | APART) == USED | APART)
-            .then(|| (j as usize, cache.half[id as usize].seen((j as usize) < i)))
-    })
 }
 
 /// Continuity rates dρ̄/dt (eq. 22, plus the fluid's density diffusion where it has one) of
@@ -153,7 +138,7 @@ pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst]) -> Vec<(f64, f64)>
                     f.pressure(p.rho[i], EOS_POROSITY),
                     f.sound_speed(p.rho[i], EOS_POROSITY),
                 ),
-                None if c.deformable => (c.pressure(p.rho[i], p.rho0[i]), c.sound),
+                None if c.deformable => (c.pressure(p.rho[i], p.rho0[i], p.energy[i]), c.sound),
                 None => (0.0, 0.0),
             }
         })

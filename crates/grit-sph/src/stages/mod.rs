@@ -6,6 +6,7 @@ mod abrasives;
 mod ceiling;
 mod contact;
 mod density_filter;
+mod energy;
 mod fluid;
 mod forces;
 mod integrate;
@@ -23,6 +24,7 @@ pub(crate) use ceiling::ceiling;
 pub use ceiling::CeilingPass;
 pub(crate) use contact::{contact, PassedThrough};
 pub(crate) use density_filter::filter_density;
+pub(crate) use energy::{add_heat, any_solid_energy, solid_energy_rates};
 use fluid::fluid_dt;
 pub use fluid::WallLoad;
 pub(crate) use fluid::{
@@ -113,15 +115,22 @@ pub(crate) struct BodyConst {
 }
 
 impl BodyConst {
-    /// Pressure of a particle of density `rho` and reference density `rho0`: K (ρ/ρ0 − 1)
-    /// (seed eq. 11), or the Mie–Grüneisen cold curve (e = 0: no energy equation is
-    /// integrated; docs/jet.md#equations-of-state gives the deficit that leaves).
+    /// Pressure of a particle of density `rho`, reference density `rho0` and specific internal
+    /// energy `e`: K (ρ/ρ0 − 1) (seed eq. 11, which ignores e), or the Mie–Grüneisen law (AWJ
+    /// paper eq. 24).
     #[inline]
-    pub fn pressure(&self, rho: f64, rho0: f64) -> f64 {
+    pub fn pressure(&self, rho: f64, rho0: f64, e: f64) -> f64 {
         match &self.eos {
             None => self.bulk * (rho / rho0 - 1.0),
-            Some(eos) => eos.pressure(rho.min(self.rho_cap), 0.0),
+            Some(eos) => eos.pressure(rho.min(self.rho_cap), e),
         }
+    }
+
+    /// Whether the body's particles integrate an internal energy: a solid whose pressure law
+    /// reads one (Mie–Grüneisen). A fluid stays on its cold curve (docs/jet.md#energy).
+    #[inline]
+    pub fn has_energy(&self) -> bool {
+        self.deformable && self.eos.is_some()
     }
 }
 
@@ -182,7 +191,7 @@ mod tests {
         let (rho, rho0) = (7911.3, steel.density_kg_m3);
         assert_eq!(c.bulk, steel.bulk_modulus());
         assert_eq!(
-            c.pressure(rho, rho0).to_bits(),
+            c.pressure(rho, rho0, 0.0).to_bits(),
             (steel.bulk_modulus() * (rho / rho0 - 1.0)).to_bits()
         );
         // Copper: the Mie–Grüneisen cold curve, with ρ0 c0² as the bulk modulus and in the
@@ -193,8 +202,15 @@ mod tests {
         assert_eq!(c.bulk, eos.bulk_modulus());
         assert_eq!(c.bulk, 8960.0 * 3940.0 * 3940.0);
         let rho = 1.05 * cu.density_kg_m3;
-        assert_eq!(c.pressure(rho, cu.density_kg_m3), eos.pressure(rho, 0.0));
-        assert!(c.pressure(rho, cu.density_kg_m3) > cu.bulk_modulus() * 0.05);
+        assert_eq!(
+            c.pressure(rho, cu.density_kg_m3, 0.0),
+            eos.pressure(rho, 0.0)
+        );
+        assert_eq!(
+            c.pressure(rho, cu.density_kg_m3, 1e4),
+            eos.pressure(rho, 1e4)
+        );
+        assert!(c.pressure(rho, cu.density_kg_m3, 0.0) > cu.bulk_modulus() * 0.05);
         let g = cu.shear_modulus();
         assert_eq!(
             c.sound,
@@ -202,8 +218,8 @@ mod tests {
         );
         // Crushed past the singular compression: large, finite, and no larger than at the cap.
         let crushed = cu.density_kg_m3 * (1.0 + 1.1 * eos.singular_compression());
-        let p = c.pressure(crushed, cu.density_kg_m3);
-        assert!(p.is_finite() && p > 0.0 && p == c.pressure(c.rho_cap, cu.density_kg_m3));
+        let p = c.pressure(crushed, cu.density_kg_m3, 0.0);
+        assert!(p.is_finite() && p > 0.0 && p == c.pressure(c.rho_cap, cu.density_kg_m3, 0.0));
     }
 }
 

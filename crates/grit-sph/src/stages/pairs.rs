@@ -199,6 +199,22 @@ pub(crate) fn fill_half_pairs(
         });
 }
 
+/// The used same-body pairs of particle `i` this step, seen from `i`: (j, pair).
+pub(crate) fn pairs_of<'a>(
+    s: super::SphView<'a>,
+    hi: &'a HalfIndex,
+    cache: &'a PairCache,
+    i: usize,
+) -> impl Iterator<Item = (usize, HalfPair)> + 'a {
+    let nl = s.nl;
+    let ids = &hi.id[nl.start[i] as usize..];
+    nl.of(i).iter().zip(ids).filter_map(move |(&j, &id)| {
+        let bits = cache.flags[id as usize];
+        (bits & (USED | APART) == USED | APART)
+            .then(|| (j as usize, cache.half[id as usize].seen((j as usize) < i)))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

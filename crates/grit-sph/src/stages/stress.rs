@@ -75,6 +75,7 @@ pub(crate) fn stress(
         .zip(p.eps_p.par_iter_mut())
         .zip(p.eps_p_rate.par_iter_mut())
         .zip(p.temp.par_iter_mut())
+        .zip(p.energy.par_iter())
         .zip(p.damage.par_iter_mut())
         .zip(p.def_grad.par_iter_mut())
         .zip(p.body.par_iter())
@@ -84,7 +85,10 @@ pub(crate) fn stress(
         .par_tasks()
         .enumerate()
         .map(
-            |(i, ((((((((((rho, s), ep), epr), temp), dmg), fdef), &b), &m), &rho0), memo))| {
+            |(
+                i,
+                (((((((((((rho, s), ep), epr), temp), &en), dmg), fdef), &b), &m), &rho0), memo),
+            )| {
                 let c = bc[b as usize];
                 if !c.deformable {
                     return 0.0;
@@ -114,7 +118,7 @@ pub(crate) fn stress(
                             let wp = r.sigma_y * r.d_eps; // plastic work per volume
                             if let Some(Fracture::JohnsonCook(dm)) = &mat.damage {
                                 let seq = von_mises(&r.sdev);
-                                let pr = c.pressure(*rho, rho0);
+                                let pr = c.pressure(*rho, rho0, en);
                                 let triax = if seq > 0.0 { -pr / seq } else { 0.0 };
                                 let ef = physics::fracture_strain(dm, jc, triax, *epr, *temp);
                                 *dmg += r.d_eps / ef;

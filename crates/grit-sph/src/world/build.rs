@@ -36,6 +36,7 @@ impl World {
         p.eps_p.push(0.0);
         p.eps_p_rate.push(0.0);
         p.temp.push(self.settings.temperature_k);
+        p.energy.push(0.0);
         p.damage.push(0.0);
         p.def_grad.push(Matrix::identity());
         p.x_ref.push(x);

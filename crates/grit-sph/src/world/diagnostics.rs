@@ -13,8 +13,13 @@ pub struct Energy {
     /// Kinetic energy of deformable and fluid particles, rigid bodies and abrasive grains (a
     /// grain's per metre of depth is its disc's, `plane_mass`).
     pub kinetic: f64,
-    /// Elastic strain energy: V (p²/2K + s:s/4G) summed over deformable particles.
+    /// Elastic strain energy: V (p²/2K + s:s/4G) summed over deformable particles whose
+    /// pressure law ignores the internal energy (seed eq. 11).
     pub elastic: f64,
+    /// Internal energy Σ m e of the particles that integrate one (Mie–Grüneisen solids:
+    /// compression, deviatoric and dissipated work, the e of AWJ paper eq. 24).
+    #[serde(default)]
+    pub internal: f64,
     /// Energy stored in the contact repulsion springs.
     pub contact: f64,
     /// Potential energy in gravity.
@@ -22,9 +27,9 @@ pub struct Energy {
 }
 
 impl Energy {
-    /// Kinetic plus elastic plus contact plus gravity.
+    /// Kinetic plus elastic plus internal plus contact plus gravity.
     pub fn total(&self) -> f64 {
-        self.kinetic + self.elastic + self.contact + self.gravity
+        self.kinetic + self.elastic + self.internal + self.contact + self.gravity
     }
 }
 
@@ -59,21 +64,23 @@ impl World {
         let mut e = Energy::default();
         for i in 0..p.len() {
             let b = p.body[i] as usize;
-            if bc[b].fluid.is_some() {
-                // The fluid's compression energy is not booked.
-                e.kinetic += 0.5 * p.mass[i] * p.vel[i].norm_squared();
-                e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
-                continue;
-            }
-            if !bc[b].deformable {
+            if !(bc[b].deformable || bc[b].fluid.is_some()) {
                 continue;
             }
             e.kinetic += 0.5 * p.mass[i] * p.vel[i].norm_squared();
+            e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
+            if bc[b].fluid.is_some() {
+                // The fluid runs on its EOS's cold curve; its compression energy is not booked.
+                continue;
+            }
+            if bc[b].has_energy() {
+                e.internal += p.mass[i] * p.energy[i];
+                continue;
+            }
             let vol = p.mass[i] / p.rho[i];
-            let pr = bc[b].pressure(p.rho[i], p.rho0[i]);
+            let pr = bc[b].pressure(p.rho[i], p.rho0[i], 0.0);
             e.elastic += vol
                 * (pr * pr / (2.0 * bc[b].bulk) + dev_contract(&p.sdev[i]) / (4.0 * bc[b].shear));
-            e.gravity -= p.mass[i] * self.settings.gravity_m_s2.dot(&p.pos[i]);
         }
         for b in &self.bodies {
             if let Some(r) = b.rigid() {

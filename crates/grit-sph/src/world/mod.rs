@@ -61,6 +61,10 @@ struct Scratch {
     state: Vec<(f64, f64)>,
     /// θ_a of the AWJ paper eq. 43 per particle: the fluid's pressure and laminar acceleration.
     theta: Vec<Vector>,
+    /// Energy rates per particle this step (J/kg/s): the solids' stress power and heating.
+    heat: Vec<f64>,
+    /// Velocities at the start of the integration, for the solids' energy at mid-step.
+    vel_start: Vec<Vector>,
     /// The grains' pairs with the fluid at the step's start.
     frame: stages::CouplingFrame,
     /// Loads on the grains from the fluid and the target.
@@ -74,6 +78,7 @@ pub struct World {
     kernel: Kernel,
     bodies: Vec<Body>,
     contacts: Vec<ContactPair>,
+    #[serde(deserialize_with = "crate::particles::deserialize_filled")]
     particles: Particles,
     time: f64,
     steps: u64,
@@ -620,7 +625,39 @@ impl World {
         stages::rigid(&mut self.bodies, &mut self.particles, g, self.time, dt);
     }
 
+    /// Advances the internal energy of the energy-carrying solids over the step just
+    /// integrated, at the step's mean velocities: with them the stress forces' work on the
+    /// motion is exactly what the particles' energy gains (docs/jet.md#energy).
+    fn solid_energy(&mut self, bc: &[BodyConst], dt: f64) {
+        let sc = &mut self.scratch;
+        let v_mid: Vec<Vector> = sc
+            .vel_start
+            .iter()
+            .zip(&self.particles.vel)
+            .map(|(a, b)| (a + b) * 0.5)
+            .collect();
+        let s = SphView {
+            p: &self.particles,
+            nl: &self.nbrs.same,
+            k: &self.kernel,
+            bc,
+        };
+        sc.heat.clear();
+        sc.heat.resize(s.p.len(), 0.0);
+        let (hi, sh, av) = (
+            &self.nbrs.half,
+            &sc.sums.shepard,
+            self.settings.solid_viscosity,
+        );
+        stages::solid_energy_rates(s, hi, &sc.pairs, sh, av, &v_mid, &mut sc.heat);
+        stages::add_heat(&mut self.particles, bc, &sc.heat, dt);
+    }
+
     fn integrate(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
+        let solid_energy = stages::any_solid_energy(bc);
+        if solid_energy {
+            self.scratch.vel_start.clone_from(&self.particles.vel);
+        }
         let blowup = stages::integrate(
             &mut self.particles,
             &self.bodies,
@@ -632,7 +669,12 @@ impl World {
             dt,
         );
         let what = match blowup {
-            None => return Ok(()),
+            None => {
+                if solid_energy {
+                    self.solid_energy(bc, dt);
+                }
+                return Ok(());
+            }
             Some(Blowup::Particle { index: i, what }) => {
                 let p = &self.particles;
                 format!(

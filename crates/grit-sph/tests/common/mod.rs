@@ -18,14 +18,15 @@ pub fn stepped_on(threads: usize, steps: usize, world: impl FnOnce() -> World + 
     })
 }
 
-/// The bits of every particle's position, velocity and density, and of the next step.
+/// The bits of every particle's position, velocity, density and internal energy, and of the
+/// next step.
 pub fn flow_bits(w: &World) -> Vec<u64> {
     let p = w.particles();
     p.pos
         .iter()
         .chain(&p.vel)
         .flat_map(|x| [x.x.to_bits(), x.y.to_bits()])
-        .chain(p.rho.iter().map(|r| r.to_bits()))
+        .chain(p.rho.iter().chain(&p.energy).map(|r| r.to_bits()))
         .chain([w.dt().to_bits()])
         .collect()
 }

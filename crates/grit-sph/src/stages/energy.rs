@@ -1,0 +1,82 @@
+//! The energy equation of the solids whose pressure law reads a specific internal energy e
+//! (a Mie–Grüneisen EOS, AWJ paper eq. 24; docs/jet.md#energy): ρ ė = σ:D plus the heat the
+//! solid's artificial viscosity dissipates (Monaghan 1992, eq. 2.27), gathered per particle in
+//! the form that returns exactly the work its pair forces take from the motion.
+
+use rayon::prelude::*;
+
+use super::pairs::{pairs_of, PairCache};
+use super::{BodyConst, ParTasks, SphView};
+use crate::fluid::{self, ArtificialViscosity};
+use crate::math::{Matrix, Vector};
+use crate::neighbours::HalfIndex;
+use crate::particles::{Particles, KINEMATIC};
+
+/// Whether some deformable body integrates an energy: only then do its same-body pairs need
+/// a pass of their own.
+pub(crate) fn any_solid_energy(bc: &[BodyConst]) -> bool {
+    bc.iter().any(|c| c.deformable && c.has_energy())
+}
+
+/// Adds to `heat` (J/kg/s, one per particle) the energy rate of each energy-carrying solid
+/// particle i from its same-body pairs at velocities `vel`: the stress power
+/// −Σ_j m_j v_ij·(σ_i/(ρ_i² Γ_i)) ∇_i W_ij, particle i's share of the work of the forces' stress
+/// term (seed eqs. 6, 9), and, with the solid's artificial viscosity `av`, the heat
+/// ½ m_j Π_ij v_ij·∇_i W_ij it dissipates. `sh` holds the Shepard sums Γ; summed in row order.
+pub(crate) fn solid_energy_rates(
+    s: SphView<'_>,
+    hi: &HalfIndex,
+    cache: &PairCache,
+    sh: &[f64],
+    av: Option<ArtificialViscosity>,
+    vel: &[Vector],
+    heat: &mut [f64],
+) {
+    let SphView { p, k, bc, .. } = s;
+    let h = k.h;
+    heat.par_iter_mut()
+        .par_tasks()
+        .enumerate()
+        .for_each(|(i, q)| {
+            let c = &bc[p.body[i] as usize];
+            if !(c.deformable && carries_energy(p, bc, i)) {
+                return;
+            }
+            let pr = c.pressure(p.rho[i], p.rho0[i], p.energy[i]);
+            let a = (p.sdev[i] - Matrix::identity() * pr) / (p.rho[i] * p.rho[i] * sh[i]);
+            for (j, pair) in pairs_of(s, hi, cache, i) {
+                let vij = vel[i] - vel[j];
+                let grad = pair.xij * pair.dw_r;
+                *q -= p.mass[j] * vij.dot(&(a * grad));
+                if let Some(av) = &av {
+                    let rho_mean = 0.5 * (p.rho[i] + p.rho[j]);
+                    let pi = av.pi_ab(pair.xij, vij, c.sound, rho_mean, h);
+                    *q += fluid::viscous_heating(p.mass[j], pi, vij, grad);
+                }
+            }
+        });
+}
+
+/// Whether particle `i` integrates an internal energy: its body's pressure law reads one and
+/// it moves by its forces. A kinematic particle (a fluid's wall, a target's fixed edge) is a
+/// boundary device: the water shearing past a wall would heat it without end, and its
+/// pressure would climb with the heat.
+#[inline]
+pub(crate) fn carries_energy(p: &Particles, bc: &[BodyConst], i: usize) -> bool {
+    bc[p.body[i] as usize].has_energy() && p.flags[i] & KINEMATIC == 0
+}
+
+/// Adds `heat` · `dt` to the internal energy of every particle that carries one.
+pub(crate) fn add_heat(p: &mut Particles, bc: &[BodyConst], heat: &[f64], dt: f64) {
+    let carries: Vec<bool> = (0..p.len()).map(|i| carries_energy(p, bc, i)).collect();
+    p.energy
+        .par_iter_mut()
+        .zip(carries.par_iter())
+        .zip(heat.par_iter())
+        .par_tasks()
+        .for_each(|((e, &on), &q)| {
+            if on {
+                *e += q * dt;
+            }
+        });
+}
