@@ -2,25 +2,16 @@
 //! internal energy, so kinetic plus internal energy is conserved where the pair forces turn one
 //! into the other, and the pressure reads the energy (AWJ paper eq. 24).
 
-use grit_sph::{Material, Motion, Settings, Vector, World};
+use grit_sph::{Material, Motion, Polygon, Settings, Vector, World};
 
 const DX: f64 = 1e-4;
-
-fn lattice(nx: usize, ny: usize, origin: Vector) -> Vec<Vector> {
-    let mut pts = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            pts.push(origin + Vector::new((i as f64 + 0.5) * DX, (j as f64 + 0.5) * DX));
-        }
-    }
-    pts
-}
 
 /// A free copper block whose halves move towards each other at `speed`, no gravity.
 fn copper_squeezed(speed: f64) -> World {
     let settings = Settings::water_jet(DX, Vector::zeros());
     let mut w = World::new(settings.clone()).unwrap();
-    let pts = lattice(20, 10, Vector::new(-10.0 * DX, 0.0));
+    let block = Polygon::rectangle(-10.0 * DX, 0.0, 10.0 * DX, 10.0 * DX);
+    let pts = block.fill_lattice(DX, Vector::zeros());
     let vols = vec![DX * DX; pts.len()];
     let b = w
         .add_deformable("block", Material::copper(), &pts, &vols, Vector::zeros())

@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::pairs::{pairs_of, PairCache};
-use super::{BodyConst, ParTasks, SphView};
+use super::{BodyConst, ParTasks, SphView, MIN_SUPPORT_NEIGHBOURS};
 use crate::fluid::{self, ArtificialViscosity};
 use crate::math::{Matrix, Vector};
 use crate::neighbours::HalfIndex;
@@ -19,7 +19,7 @@ pub(crate) fn any_solid_energy(bc: &[BodyConst]) -> bool {
 }
 
 /// Adds to `heat` (J/kg/s, one per particle) the energy rate of each energy-carrying solid
-/// particle i from its same-body pairs at velocities `vel`: the stress power
+/// particle i with a full support (the forces' own test) from its same-body pairs at velocities `vel`: the stress power
 /// −Σ_j m_j v_ij·(σ_i/(ρ_i² Γ_i)) ∇_i W_ij, particle i's share of the work of the forces' stress
 /// term (seed eqs. 6, 9), and, with the solid's artificial viscosity `av`, the heat
 /// ½ m_j Π_ij v_ij·∇_i W_ij it dissipates. `sh` holds the Shepard sums Γ; summed in row order.
@@ -39,7 +39,10 @@ pub(crate) fn solid_energy_rates(
         .enumerate()
         .for_each(|(i, q)| {
             let c = &bc[p.body[i] as usize];
-            if !(c.deformable && carries_energy(p, bc, i)) {
+            // A fragment (too few neighbours) takes no stress force and flies ballistically, so
+            // no stress power either: its pairs would heat it through a vanishing Γ_i.
+            let whole = cache.count[i] >= MIN_SUPPORT_NEIGHBOURS;
+            if !(c.deformable && whole && carries_energy(p, bc, i)) {
                 return;
             }
             let pr = c.pressure(p.rho[i], p.rho0[i], p.energy[i]);
