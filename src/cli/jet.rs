@@ -221,7 +221,8 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
             // The grains that first touched the target in the slice, and their mean approach
             // speed along the contact normal.
             let (hits, v_n) = s.grain_hits.map_or((0, "-".to_string()), |h| {
-                (h.count, format!("{:.0}", h.normal_speed_m_s.mean))
+                let v_n = h.normal_speed_m_s.map(|v| format!("{:.0}", v.mean));
+                (h.count, v_n.unwrap_or_else(|| "-".to_string()))
             });
             say!(
                 "{:>9.4} {:>12.4e} {:>10.1} {:>10.1} {:>8.3} {:>7} {:>5} {:>11}",

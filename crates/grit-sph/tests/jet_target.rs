@@ -132,24 +132,28 @@ fn grains_in_the_water_and_on_the_target_conserve_momentum() {
 }
 
 #[test]
-fn each_grain_logs_its_first_touch_of_the_target_once_with_its_speed_then() {
+fn each_grain_logs_each_contact_start_with_its_speed_then_and_flags_its_first() {
     let mut w = water_on_copper(100.0, true);
-    let (mut hits, mut touching_steps) = (Vec::new(), 0);
+    let (mut starts, mut steps_in_contact) = (Vec::new(), 0);
     for _ in 0..600 {
-        let before: Vec<Vector> = w
-            .abrasives()
-            .unwrap()
-            .dem
-            .grains
-            .iter()
-            .map(|g| g.vel)
-            .collect();
+        let grains = &w.abrasives().unwrap().dem.grains;
+        let before: Vec<(Vector, bool)> = grains.iter().map(|g| (g.vel, g.in_contact)).collect();
         w.step().unwrap();
-        let new = w.take_grain_hits();
-        for h in &new {
+        let c = w.take_grain_contacts();
+        let grains = &w.abrasives().unwrap().dem.grains;
+        // A start is logged for each grain that touches now and did not in the step before.
+        let begun = grains
+            .iter()
+            .zip(&before)
+            .filter(|(g, b)| g.in_contact && !b.1)
+            .count();
+        assert_eq!(c.starts.len(), begun);
+        let touching = grains.iter().filter(|g| g.in_contact).count() as u64;
+        assert_eq!(c.steps_in_contact, touching);
+        for h in &c.starts {
             // The logged speed is a grain's speed at the start of the step it touched in.
             assert!(
-                before.iter().any(|v| v.norm() == h.speed_m_s),
+                before.iter().any(|b| b.0.norm() == h.speed_m_s),
                 "{h:?} is no grain's speed at the step's start"
             );
             assert!(
@@ -157,18 +161,22 @@ fn each_grain_logs_its_first_touch_of_the_target_once_with_its_speed_then() {
                 "{h:?}"
             );
         }
-        hits.extend(new);
-        touching_steps += usize::from(w.contact_forces().iter().any(|f| f.norm() > 0.0));
+        starts.extend(c.starts);
+        steps_in_contact += c.steps_in_contact;
     }
-    assert_eq!(hits.len(), 2, "one first touch per grain: {hits:?}");
+    let first = starts.iter().filter(|h| h.first).count();
+    assert_eq!(first, 2, "one first touch per grain: {starts:?}");
     assert!(
-        touching_steps > 2,
-        "the grains stayed in contact for {touching_steps} steps"
+        steps_in_contact > 2,
+        "the grains stayed in contact for {steps_in_contact} grain-steps"
     );
     assert!(w.abrasives().unwrap().dem.grains.iter().all(|g| g.touched));
-    // An untouched grain keeps the bytes it had before the flag existed.
+    // An untouched grain keeps the bytes it had before the flags existed.
     let fresh = serde_json::to_string(&Grain::sphere(Vector::zeros(), 1e-4, 4120.0)).unwrap();
-    assert!(!fresh.contains("touched"), "{fresh}");
+    assert!(
+        !fresh.contains("touched") && !fresh.contains("in_contact"),
+        "{fresh}"
+    );
 }
 
 #[test]

@@ -13,7 +13,7 @@ mod scene;
 
 use grit_sph::crater::{self, CraterOptions, CraterSample};
 use grit_sph::dem::DemParams;
-use grit_sph::world::GrainHit;
+use grit_sph::world::GrainContacts;
 use grit_sph::{InputError, PenaltyParams, SimError, Timers, World};
 use serde::{Deserialize, Serialize};
 
@@ -267,37 +267,57 @@ pub struct JetSlice {
     pub water_fed_kg_m: f64,
     /// Wall-clock seconds the slice took.
     pub wall_s: f64,
-    /// The grains that first touched the target in the slice and how fast they came; absent
-    /// when none did (and from runs stored before it was recorded).
+    /// How the grains met the target in the slice: first touches and how fast they came,
+    /// returns, time in contact; absent when no grain touched it (and from runs stored before
+    /// it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grain_hits: Option<GrainHits>,
 }
 
-/// The grains' first touches of the target in one slice (`World::take_grain_hits`): how fast
-/// the jet delivers its grains, beside the AWJ paper's single grain in a jet
-/// (docs/jet.md#how-fast-the-grains-arrive).
+/// The grains' contacts with the target in one slice (`World::take_grain_contacts`): how fast
+/// the jet delivers its grains, beside the AWJ paper's single grain in a jet, and how long they
+/// stay (docs/jet.md#how-fast-the-grains-arrive).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GrainHits {
     /// Grains that touched the target for the first time.
     pub count: usize,
-    /// Their speed |v| at the touch (m/s).
-    pub speed_m_s: Stats,
-    /// Their approach speed along the normal of the first contact (m/s).
-    pub normal_speed_m_s: Stats,
+    /// Their speed |v| at the touch (m/s); absent when none touched first in the slice.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_m_s: Option<Stats>,
+    /// Their approach speed along the normal of the first contact (m/s); absent likewise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_speed_m_s: Option<Stats>,
     /// The fastest of them, |v| (m/s): a grain faster than the jet has been thrown by a contact.
     pub fastest_m_s: f64,
+    /// Contact starts of grains that had touched the target before: returns after leaving it.
+    #[serde(default)]
+    pub returns: usize,
+    /// Σ |v|² over every contact start, first touches and returns (m²/s²): the kinetic energy
+    /// per unit mass the grains bring to their contacts.
+    #[serde(default)]
+    pub start_speed_sq_sum_m2_s2: f64,
+    /// Grain-steps in contact: over the slice's steps, the number of grains touching in each.
+    #[serde(default)]
+    pub steps_in_contact: u64,
 }
 
 impl GrainHits {
-    /// The statistics of `hits`; `None` when there are none.
-    pub fn of(hits: &[GrainHit]) -> Option<GrainHits> {
-        let speeds: Vec<f64> = hits.iter().map(|h| h.speed_m_s).collect();
-        let normal: Vec<f64> = hits.iter().map(|h| h.normal_speed_m_s).collect();
+    /// The statistics of a slice's `contacts`; `None` when no grain touched the target.
+    pub fn of(contacts: &GrainContacts) -> Option<GrainHits> {
+        if contacts.starts.is_empty() && contacts.steps_in_contact == 0 {
+            return None;
+        }
+        let first: Vec<_> = contacts.starts.iter().filter(|h| h.first).collect();
+        let speeds: Vec<f64> = first.iter().map(|h| h.speed_m_s).collect();
+        let normal: Vec<f64> = first.iter().map(|h| h.normal_speed_m_s).collect();
         Some(GrainHits {
-            count: hits.len(),
-            speed_m_s: stats(&speeds)?,
-            normal_speed_m_s: stats(&normal)?,
+            count: first.len(),
+            speed_m_s: stats(&speeds),
+            normal_speed_m_s: stats(&normal),
             fastest_m_s: speeds.iter().copied().fold(0.0, f64::max),
+            returns: contacts.starts.len() - first.len(),
+            start_speed_sq_sum_m2_s2: contacts.starts.iter().map(|h| h.speed_m_s.powi(2)).sum(),
+            steps_in_contact: contacts.steps_in_contact,
         })
     }
 }
@@ -451,7 +471,7 @@ impl JetRun {
         let steps0 = self.world.steps();
         self.world.timers_mut().reset();
         // A slice abandoned by `cancel` may have left touches of its own in the log.
-        self.world.take_grain_hits();
+        self.world.take_grain_contacts();
         while self.world.time() < t_end {
             if cancel() {
                 return Ok(None);
@@ -463,7 +483,7 @@ impl JetRun {
                 f(&self.world);
             }
         }
-        let hits = self.world.take_grain_hits();
+        let hits = self.world.take_grain_contacts();
         let slice = self.measure(
             k + 1,
             self.world.steps() - steps0,
@@ -482,7 +502,7 @@ impl JetRun {
         slice: u32,
         steps: u64,
         wall_s: f64,
-        hits: &[GrainHit],
+        hits: &GrainContacts,
     ) -> Result<JetSlice, JetError> {
         let w = &self.world;
         let opts = CraterOptions::for_spacing(self.params.spacing_m);

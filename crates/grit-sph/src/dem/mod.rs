@@ -46,6 +46,11 @@ pub struct Grain {
     /// the JSON while false, so grains stored before it keep their bytes.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub touched: bool,
+    /// Whether the grain touched a deformable particle in the last step: a step in which it
+    /// touches and did not before starts a contact (logged as a [`crate::world::GrainHit`]).
+    /// Absent from the JSON while false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub in_contact: bool,
 }
 
 impl Grain {
@@ -62,6 +67,7 @@ impl Grain {
             mass_kg: mass,
             inertia_kg_m2: 0.4 * mass * r * r,
             touched: false,
+            in_contact: false,
         }
     }
 

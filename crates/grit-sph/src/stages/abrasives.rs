@@ -121,8 +121,8 @@ pub(crate) fn coupling_forces(
 /// The penalty contact (eqs. 12–14) between every grain and the deformable particles within
 /// `d_ini` of its surface: the force on each particle into `contact_force`, the reaction and
 /// its torque about the grain's centre into `loads`. `d_ini` is the particle spacing and `dt`
-/// the SPH step. Returns the grains not yet `touched` that touch now, each with its approach
-/// speed along the normal of its first contact (in particle order).
+/// the SPH step. Returns every grain that touches now, in grain order, with its approach speed
+/// along the normal of its first contact in particle order.
 pub(crate) fn penalty(
     p: &Particles,
     bc: &[BodyConst],
@@ -170,7 +170,7 @@ pub(crate) fn penalty(
             ) else {
                 continue;
             };
-            if !grain.touched && touches.last().is_none_or(|&(t, _)| t != g) {
+            if touches.last().is_none_or(|&(t, _)| t != g) {
                 let n = (c.point - grain.pos) / grain.radius_m;
                 touches.push((g, (grain.vel - p.vel[i]).dot(&n)));
             }

@@ -81,14 +81,29 @@ pub struct Abrasives {
     /// DEM sub-steps taken in the last SPH step.
     #[serde(skip)]
     pub substeps: u32,
-    /// First touches of the target since the log was last taken (`World::take_grain_hits`).
+    /// Contact starts with the target since the log was last taken
+    /// (`World::take_grain_contacts`).
     #[serde(skip)]
     pub hits: Vec<GrainHit>,
+    /// Grain-steps in contact with the target since the log was last taken.
+    #[serde(skip)]
+    pub steps_in_contact: u64,
 }
 
-/// A grain's first touch of a deformable particle (the penalty contact of the AWJ paper
-/// eqs. 12–14): how fast the jet delivered it, to set beside the paper's single grain in a jet
-/// (166 m/s at R_c = 2 d; docs/jet.md#how-fast-the-grains-arrive).
+/// What [`World::take_grain_contacts`] hands over: the grains' contact starts with the target
+/// and how long they stayed, since it was last called.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GrainContacts {
+    /// Every contact start, first touches and returns, in the order they happened (grain
+    /// order within a step).
+    pub starts: Vec<GrainHit>,
+    /// Grain-steps in contact: over the steps, the number of grains touching in each.
+    pub steps_in_contact: u64,
+}
+
+/// The start of a grain's contact with a deformable particle (the penalty contact of the AWJ
+/// paper eqs. 12–14): how fast the jet delivered it, to set beside the paper's single grain in
+/// a jet (166 m/s at R_c = 2 d; docs/jet.md#how-fast-the-grains-arrive).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GrainHit {
     /// Time of the step in which the contact began (s).
@@ -98,6 +113,8 @@ pub struct GrainHit {
     /// Its approach speed along the contact normal, (v_grain − v_particle)·n with n from the
     /// grain's centre to the particle (m/s).
     pub normal_speed_m_s: f64,
+    /// Whether it is the grain's first touch of the target (else a return after leaving it).
+    pub first: bool,
 }
 
 impl Abrasives {
@@ -118,6 +135,7 @@ impl Abrasives {
             added: 0,
             substeps: 0,
             hits: Vec::new(),
+            steps_in_contact: 0,
         }
     }
 
@@ -180,12 +198,15 @@ impl World {
         self.abrasives.as_ref()
     }
 
-    /// The grains' first touches of the target since the last call, in the order they happened
-    /// (grain order within a step); empty without abrasives.
-    pub fn take_grain_hits(&mut self) -> Vec<GrainHit> {
+    /// The grains' contact starts with the target and their grain-steps in contact since the
+    /// last call; empty without abrasives.
+    pub fn take_grain_contacts(&mut self) -> GrainContacts {
         self.abrasives
             .as_mut()
-            .map(|ab| std::mem::take(&mut ab.hits))
+            .map(|ab| GrainContacts {
+                starts: std::mem::take(&mut ab.hits),
+                steps_in_contact: std::mem::take(&mut ab.steps_in_contact),
+            })
             .unwrap_or_default()
     }
 

@@ -12,7 +12,7 @@ mod flow;
 mod settings;
 
 pub use crate::stages::{CeilingPass, WallLoad, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
-pub use abrasives::{plane_mass, Abrasives, GrainHit, GrainOutflow, PenaltyParams};
+pub use abrasives::{plane_mass, Abrasives, GrainContacts, GrainHit, GrainOutflow, PenaltyParams};
 pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
@@ -607,15 +607,24 @@ impl World {
         let d_ini = self.settings.spacing_m;
         let cf = &mut sc.contact_force;
         let touches = stages::penalty(&self.particles, bc, ab, d_ini, dt, cf, &mut sc.loads);
-        for (g, normal_speed_m_s) in touches {
+        let mut now = vec![false; ab.dem.grains.len()];
+        for &(g, normal_speed_m_s) in &touches {
+            now[g] = true;
             let grain = &mut ab.dem.grains[g];
+            if !grain.in_contact {
+                ab.hits.push(GrainHit {
+                    t_s: self.time,
+                    speed_m_s: grain.vel.norm(),
+                    normal_speed_m_s,
+                    first: !grain.touched,
+                });
+            }
             grain.touched = true;
-            ab.hits.push(GrainHit {
-                t_s: self.time,
-                speed_m_s: grain.vel.norm(),
-                normal_speed_m_s,
-            });
         }
+        for (grain, now) in ab.dem.grains.iter_mut().zip(now) {
+            grain.in_contact = now;
+        }
+        ab.steps_in_contact += touches.len() as u64;
         ab.substeps = stages::advance(ab, dt, &sc.loads).map_err(err)?;
         Ok(())
     }
