@@ -183,7 +183,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
             // Cells that grow (until_steady, target_sem_rel) raise the total.
             bar.set_length(status.impacts_total);
             bar.set_position(status.impacts_done);
-            bar.set_message(run_message(status));
+            bar.set_message(run_message(status, units));
             if plain && last_line.is_none_or(|t| t.elapsed() >= Duration::from_secs(30)) {
                 last_line = Some(Instant::now());
                 eprintln!(
@@ -324,11 +324,12 @@ async fn warn_unsteady_remote(client: &Client, id: Uuid, finished: bool) {
     }
 }
 
-/// The bar's message while `grit run` runs: rate, ETA and jobs done.
-fn run_message(status: &CampaignStatus) -> String {
+/// The bar's message while `grit run` runs: rate in the campaign's progress `units` (impacts
+/// or slices) per second, ETA and jobs done.
+fn run_message(status: &CampaignStatus, units: &str) -> String {
     let rate = status
         .rate_impacts_per_s
-        .map_or("rate –".to_string(), |r| format!("{:.3} impacts/s", r));
+        .map_or("rate –".to_string(), |r| format!("{r:.3} {units}/s"));
     let eta = status.eta_s.map_or("ETA –".to_string(), |s| {
         format!(
             "ETA {}",
