@@ -483,12 +483,12 @@ impl JetRun {
                 f(&self.world);
             }
         }
-        let hits = self.world.take_grain_contacts();
+        let contacts = self.world.take_grain_contacts();
         let slice = self.measure(
             k + 1,
             self.world.steps() - steps0,
             t0.elapsed().as_secs_f64(),
-            &hits,
+            &contacts,
         )?;
         self.slices.push(slice);
         Ok(self.slices.last())
@@ -502,7 +502,7 @@ impl JetRun {
         slice: u32,
         steps: u64,
         wall_s: f64,
-        hits: &GrainContacts,
+        contacts: &GrainContacts,
     ) -> Result<JetSlice, JetError> {
         let w = &self.world;
         let opts = CraterOptions::for_spacing(self.params.spacing_m);
@@ -535,7 +535,7 @@ impl JetRun {
             water_deleted_kg_m: w.bodies()[self.layout.fluid_body].removed_mass_kg_m,
             water_fed_kg_m: w.inflows().iter().map(|i| i.mass_kg_m).sum(),
             wall_s,
-            grain_hits: GrainHits::of(hits),
+            grain_hits: GrainHits::of(contacts),
         })
     }
 

@@ -12,17 +12,20 @@ use crate::math::{Matrix, Vector};
 use crate::neighbours::HalfIndex;
 use crate::particles::{Particles, KINEMATIC};
 
-/// Whether some deformable body integrates an energy: only then do its same-body pairs need
-/// a pass of their own.
+/// Whether some body integrates an energy: only then do its same-body pairs need a pass of
+/// their own.
 pub(crate) fn any_solid_energy(bc: &[BodyConst]) -> bool {
-    bc.iter().any(|c| c.deformable && c.has_energy())
+    bc.iter().any(BodyConst::has_energy)
 }
 
-/// Adds to `heat` (J/kg/s, one per particle) the energy rate of each energy-carrying solid
-/// particle i with a full support (the forces' own test) from its same-body pairs at velocities `vel`: the stress power
+/// Adds to `heat` (J/kg/s, one per particle) the energy rate of each particle that carries an
+/// energy, from its same-body pairs at velocities `vel`: the stress power
 /// −Σ_j m_j v_ij·(σ_i/(ρ_i² Γ_i)) ∇_i W_ij, particle i's share of the work of the forces' stress
 /// term (seed eqs. 6, 9), and, with the solid's artificial viscosity `av`, the heat
 /// ½ m_j Π_ij v_ij·∇_i W_ij it dissipates. `sh` holds the Shepard sums Γ; summed in row order.
+/// A particle carries an energy when its body's pressure law reads one, it moves by its forces
+/// (not kinematic: a target's fixed edge follows its prescribed motion) and it has a full
+/// support (the forces' own test); every other particle's rate stays 0.
 pub(crate) fn solid_energy_rates(
     s: SphView<'_>,
     hi: &HalfIndex,
@@ -42,7 +45,7 @@ pub(crate) fn solid_energy_rates(
             // A fragment (too few neighbours) takes no stress force and flies ballistically, so
             // no stress power either: its pairs would heat it through a vanishing Γ_i.
             let whole = cache.count[i] >= MIN_SUPPORT_NEIGHBOURS;
-            if !(c.deformable && whole && carries_energy(p, bc, i)) {
+            if !(c.has_energy() && p.flags[i] & KINEMATIC == 0 && whole) {
                 return;
             }
             let pr = c.pressure(p.rho[i], p.rho0[i], p.energy[i]);
@@ -60,26 +63,12 @@ pub(crate) fn solid_energy_rates(
         });
 }
 
-/// Whether particle `i` integrates an internal energy: its body's pressure law reads one and
-/// it moves by its forces. A kinematic particle (a fluid's wall, a target's fixed edge) is a
-/// boundary device: the water shearing past a wall would heat it without end, and its
-/// pressure would climb with the heat.
-#[inline]
-pub(crate) fn carries_energy(p: &Particles, bc: &[BodyConst], i: usize) -> bool {
-    bc[p.body[i] as usize].has_energy() && p.flags[i] & KINEMATIC == 0
-}
-
-/// Adds `heat` · `dt` to the internal energy of every particle that carries one.
-pub(crate) fn add_heat(p: &mut Particles, bc: &[BodyConst], heat: &[f64], dt: f64) {
-    let carries: Vec<bool> = (0..p.len()).map(|i| carries_energy(p, bc, i)).collect();
+/// Adds `heat` · `dt` to every particle's internal energy (`heat` is 0 wherever
+/// [`solid_energy_rates`] left a particle out).
+pub(crate) fn add_heat(p: &mut Particles, heat: &[f64], dt: f64) {
     p.energy
         .par_iter_mut()
-        .zip(carries.par_iter())
         .zip(heat.par_iter())
         .par_tasks()
-        .for_each(|((e, &on), &q)| {
-            if on {
-                *e += q * dt;
-            }
-        });
+        .for_each(|(e, &q)| *e += q * dt);
 }

@@ -63,7 +63,8 @@ struct Scratch {
     theta: Vec<Vector>,
     /// Energy rates per particle this step (J/kg/s): the solids' stress power and heating.
     heat: Vec<f64>,
-    /// Velocities at the start of the integration, for the solids' energy at mid-step.
+    /// Velocities at the start of the integration, then the step's mean velocities, for the
+    /// solids' energy at mid-step.
     vel_start: Vec<Vector>,
     /// The grains' pairs with the fluid at the step's start.
     frame: stages::CouplingFrame,
@@ -639,12 +640,10 @@ impl World {
     /// motion is exactly what the particles' energy gains (docs/jet.md#energy).
     fn solid_energy(&mut self, bc: &[BodyConst], dt: f64) {
         let sc = &mut self.scratch;
-        let v_mid: Vec<Vector> = sc
-            .vel_start
-            .iter()
-            .zip(&self.particles.vel)
-            .map(|(a, b)| (a + b) * 0.5)
-            .collect();
+        // The step's start velocities become its mean ones in place.
+        for (v, end) in sc.vel_start.iter_mut().zip(&self.particles.vel) {
+            *v = (*v + end) * 0.5;
+        }
         let s = SphView {
             p: &self.particles,
             nl: &self.nbrs.same,
@@ -658,8 +657,9 @@ impl World {
             &sc.sums.shepard,
             self.settings.solid_viscosity,
         );
-        stages::solid_energy_rates(s, hi, &sc.pairs, sh, av, &v_mid, &mut sc.heat);
-        stages::add_heat(&mut self.particles, bc, &sc.heat, dt);
+        let v_mid = &sc.vel_start;
+        stages::solid_energy_rates(s, hi, &sc.pairs, sh, av, v_mid, &mut sc.heat);
+        stages::add_heat(&mut self.particles, &sc.heat, dt);
     }
 
     fn integrate(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
