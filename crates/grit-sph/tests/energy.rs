@@ -43,6 +43,8 @@ fn squeezed_copper_keeps_kinetic_plus_internal_energy() {
     // force's work (0.2–0.5 %) and the few edge particles without a full support.
     for speed in [0.5, 20.0, 200.0] {
         let (total, internal) = budget(copper_squeezed(speed), 600);
+        // docs/jet.md#energy quotes these (`-- --nocapture`).
+        println!("{speed} m/s: E/E0 = {total:.5}, internal/E0 = {internal:.4}");
         assert!(internal > 0.5, "{speed} m/s: internal {internal}");
         assert!((total - 1.0).abs() < 0.025, "{speed} m/s: total {total}");
     }
