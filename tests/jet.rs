@@ -109,16 +109,31 @@ fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
         "300",
         "--rc",
         "2",
+        "--releases",
+        "2",
         "--json",
     ]);
     let v = json_of(&out);
     assert_eq!(v["scene"]["jet_speed_m_s"], 300.0);
+    assert_eq!(v["scene"]["releases"], 2);
     let rides = v["rides"].as_array().unwrap();
     assert_eq!(rides.len(), 1);
     assert_eq!(rides[0]["label"], "R_c = 2 d");
     // The grain is braked in the stagnation zone, never sped up past the jet.
     let speed = rides[0]["contact_speed_m_s"].as_f64().unwrap();
     assert!(speed > 0.0 && speed < 300.0, "{speed}");
+    // The contact speed is the mean of the two releases, which land apart in a jet that is
+    // not perfectly steady.
+    let each: Vec<f64> = rides[0]["contact_speeds_m_s"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(each.len(), 2);
+    assert!((speed - 0.5 * (each[0] + each[1])).abs() < 1e-9 * speed, "{each:?}");
+    let std = rides[0]["contact_speed_std_m_s"].as_f64().unwrap();
+    assert!((std - (each[0] - each[1]).abs() / 2f64.sqrt()).abs() < 1e-9 * speed, "{std}");
     // On its way in it was faster the farther from the wall, and at 0.125 d from contact
     // already near its contact speed.
     let before = rides[0]["speed_before_contact"].as_array().unwrap();
@@ -133,6 +148,9 @@ fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
         (vec!["--release-ratio", "3"], "--release-ratio"),
         (vec!["--switch-porosity", "1.5"], "--switch-porosity"),
         (vec!["--rc", "0"], "--rc"),
+        (vec!["--cfl", "0"], "--cfl"),
+        (vec!["--releases", "0"], "--releases"),
+        (vec!["--release-at-b-over-v=-1"], "--release-at-b-over-v"),
         // 8 across is 0.125 mm per particle: too coarse to resolve a 0.2 mm grain.
         (
             vec!["--across", "8", "--rc", "2", "--resolved"],

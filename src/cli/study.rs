@@ -27,8 +27,8 @@ enum Study {
         after_help = "Example: grit study rc --across 32 --jet-speed-m-s 500 --release-ratio 1 --resolved"
     )]
     Rc {
-        /// Water particles across the 1 mm jet (even; at 500 m/s a resolved grain ran at 32 to 44
-        /// across, and failed at 24 and at 48 or more: docs/jet.md#one-grain-in-the-jet).
+        /// Water particles across the 1 mm jet (even; at 500 m/s a resolved grain runs from 32
+        /// across, and from 48 across the jet needs --cfl 0.1: docs/jet.md#one-grain-in-the-jet).
         #[arg(long, default_value_t = 16)]
         across: usize,
         /// The jet's speed (m/s).
@@ -41,6 +41,18 @@ enum Study {
         /// (the paper's 0.8; eq. 44).
         #[arg(long, default_value_t = DEFAULT_SWITCH_POROSITY)]
         switch_porosity: f64,
+        /// Courant number of the steps (the paper's 0.2; a 500 m/s jet 48 or more across fails
+        /// at it while settling and runs at 0.1).
+        #[arg(long, default_value_t = RcScene::DEFAULT_CFL)]
+        cfl: f64,
+        /// When the first grain leaves the nozzle, in transit times b/v from the jet's start (its
+        /// head reaches the wall at 2; the default is once the jet has settled).
+        #[arg(long, default_value_t = RcScene::DEFAULT_RELEASE_AT)]
+        release_at_b_over_v: f64,
+        /// Grains released per ride, one transit time b/v apart into the same settled jet; a
+        /// ride's contact speed is then their mean (one landing scatters by 3–5 %).
+        #[arg(long, default_value_t = 1)]
+        releases: usize,
         /// Coupling radii R_c/d of the unresolved grains, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "1,1.5,2,2.5,3")]
         rc: Vec<f64>,
@@ -53,8 +65,9 @@ enum Study {
         /// Worker threads of the engine (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
-        /// Print {scene, rides: [{label, contact_speed_m_s, speed_before_contact: [{distance_d,
-        /// speed_m_s}]}]} as JSON.
+        /// Print {scene, rides: [{label, contact_speed_m_s (the mean over releases),
+        /// contact_speeds_m_s, contact_speed_std_m_s, speed_before_contact (the first release):
+        /// [{distance_d, speed_m_s}]}]} as JSON.
         #[arg(long)]
         json: bool,
     },
@@ -92,6 +105,9 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             jet_speed_m_s,
             release_ratio,
             switch_porosity,
+            cfl,
+            release_at_b_over_v,
+            releases,
             rc,
             resolved,
             chart,
@@ -100,24 +116,36 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
         } => {
             let scene = RcScene {
                 switch_porosity,
+                cfl,
+                release_at_b_over_v,
                 ..RcScene::new(across, jet_speed_m_s, release_ratio)
             };
-            check_rc_scene(&scene, &rc)?;
-            let rides = pool(threads)?.install(|| -> anyhow::Result<Vec<GrainRide>> {
+            check_rc_scene(&scene, &rc, releases)?;
+            let series = pool(threads)?.install(|| -> anyhow::Result<Vec<Vec<GrainRide>>> {
                 eprintln!(
                     "settling the jet and riding {} grain(s) ...",
-                    rc.len() + usize::from(resolved)
+                    releases * (rc.len() + usize::from(resolved))
                 );
-                Ok(jet_grain::rides(&scene, &rc, resolved)?)
+                Ok(jet_grain::release_series(&scene, &rc, resolved, releases)?)
             })?;
+            let rides = &series[0];
+            // Per ride: the mean and standard deviation of its releases' contact speeds.
+            let stats: Vec<(Vec<f64>, f64, f64)> = (0..rides.len())
+                .map(|k| {
+                    let v: Vec<f64> = series.iter().map(|s| s[k].contact_speed_m_s).collect();
+                    let (mean, std) = jet_grain::mean_std(&v);
+                    (v, mean, std)
+                })
+                .collect();
             if let Some(path) = &chart {
-                super::plot::line_chart(&jet_grain::rides_chart(&scene, &rides), path)?;
+                super::plot::line_chart(&jet_grain::rides_chart(&scene, rides), path)?;
                 eprintln!("wrote {}", path.display());
             }
             if json {
                 let rides: Vec<_> = rides
                     .iter()
-                    .map(|r| {
+                    .zip(&stats)
+                    .map(|(r, (speeds, mean, std))| {
                         let before: Vec<_> = BEFORE_CONTACT_D
                             .iter()
                             .map(|&d| {
@@ -129,7 +157,9 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                             .collect();
                         serde_json::json!({
                             "label": r.label,
-                            "contact_speed_m_s": r.contact_speed_m_s,
+                            "contact_speed_m_s": mean,
+                            "contact_speeds_m_s": speeds,
+                            "contact_speed_std_m_s": std,
                             "speed_before_contact": before,
                         })
                     })
@@ -139,6 +169,9 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                     "jet_speed_m_s": jet_speed_m_s,
                     "release_ratio": release_ratio,
                     "switch_porosity": switch_porosity,
+                    "cfl": cfl,
+                    "release_at_b_over_v": release_at_b_over_v,
+                    "releases": releases,
                 });
                 say!(
                     "{}",
@@ -148,18 +181,18 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                 );
                 return Ok(ExitCode::SUCCESS);
             }
-            say!("jet {jet_speed_m_s} m/s, b/dx {across}, grain released at {release_ratio} x the jet's speed");
+            say!("jet {jet_speed_m_s} m/s, b/dx {across}, CFL {cfl}, grain released at {release_ratio} x the jet's speed, first at {release_at_b_over_v} b/v, {releases} release(s) 1 b/v apart");
             let heads: String = BEFORE_CONTACT_D
                 .iter()
                 .map(|d| format!(" {:>8}", format!("{d} d")))
                 .collect();
             say!(
-                "{:<14} {:>18}   speed (m/s) this far from contact:",
+                "{:<14} {:>18}   speed (m/s) this far from contact (first release):",
                 "grain",
                 "contact speed m/s"
             );
             say!("{:<14} {:>18}  {heads}", "", "");
-            for r in &rides {
+            for (r, (each, mean, std)) in rides.iter().zip(&stats) {
                 let speeds: String = BEFORE_CONTACT_D
                     .iter()
                     .map(|&d| match r.speed_before_contact(d * GRAIN_D) {
@@ -167,7 +200,16 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                         None => format!(" {:>8}", "-"),
                     })
                     .collect();
-                say!("{:<14} {:>18.1}  {speeds}", r.label, r.contact_speed_m_s);
+                let contact = if releases > 1 {
+                    format!("{mean:.1} ± {std:.1}")
+                } else {
+                    format!("{mean:.1}")
+                };
+                say!("{:<14} {contact:>18}  {speeds}", r.label);
+                if releases > 1 {
+                    let each: Vec<String> = each.iter().map(|v| format!("{v:.1}")).collect();
+                    say!("{:<14} releases: {}", "", each.join(", "));
+                }
             }
             say!("the paper: 166 m/s unresolved at R_c = 2.0 d, 162 m/s resolved");
             Ok(ExitCode::SUCCESS)
@@ -219,7 +261,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
 }
 
 /// Refuses a coupling-radius scene the study cannot run, naming the flag and the rule.
-fn check_rc_scene(scene: &RcScene, rc: &[f64]) -> anyhow::Result<()> {
+fn check_rc_scene(scene: &RcScene, rc: &[f64], releases: usize) -> anyhow::Result<()> {
     if scene.across < 2 || !scene.across.is_multiple_of(2) {
         bail!(
             "--across: must be an even number >= 2, got {}",
@@ -243,6 +285,20 @@ fn check_rc_scene(scene: &RcScene, rc: &[f64]) -> anyhow::Result<()> {
             "--switch-porosity: must lie in (0, 1), got {}",
             scene.switch_porosity
         );
+    }
+    if !(scene.cfl > 0.0 && scene.cfl <= 1.0) {
+        bail!("--cfl: must lie in (0, 1], got {}", scene.cfl);
+    }
+    if !(scene.release_at_b_over_v.is_finite()
+        && (0.0..=100.0).contains(&scene.release_at_b_over_v))
+    {
+        bail!(
+            "--release-at-b-over-v: must lie in [0, 100], got {}",
+            scene.release_at_b_over_v
+        );
+    }
+    if !(1..=20).contains(&releases) {
+        bail!("--releases: must lie in 1..=20, got {releases}");
     }
     if let Some(f) = rc.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
         bail!("--rc: every coupling radius must be a finite number > 0, got {f}");

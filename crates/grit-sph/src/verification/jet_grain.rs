@@ -8,7 +8,7 @@
 //! nozzle on the jet's axis at the jet's speed. The wall is, for the grain, a DEM wall on the
 //! wall particles' surface; the grain meets the water only through the coupling.
 
-use super::jet_wall::{jet_wall_world, JET_B};
+use super::jet_wall::{jet_wall_world_cfl, JET_B, NOZZLE_HEIGHT_B};
 use super::{fail, CaseReport, Chart, Row, Series};
 use crate::coupling::{CouplingParams, DEFAULT_SWITCH_POROSITY};
 use crate::dem::{Dem, DemParams, Grain, Wall};
@@ -17,7 +17,7 @@ use crate::fluid::Fluid;
 use crate::geometry::Polygon;
 use crate::material::Material;
 use crate::math::Vector;
-use crate::world::{Abrasives, PenaltyParams, World};
+use crate::world::{Abrasives, PenaltyParams, Settings, World};
 
 /// The paper's contact speed of the unresolved grain at R_c = 2.0 d (m/s; its Fig. 11).
 pub const PAPER_CONTACT_SPEED: f64 = 166.0;
@@ -63,13 +63,12 @@ impl GrainRide {
     }
 }
 
-/// A steady jet on a wall, `n` particles across, at `speed` m/s: the world the grains are
-/// released into.
-pub fn settled_jet(n: usize, speed: f64) -> Result<World, SimError> {
-    let mut world = jet_wall_world(n, speed, Fluid::water())?;
-    let t_b = JET_B / speed;
-    let t_settled = (2.0 + SETTLE_B_OVER_V) * t_b;
-    world.run_until(t_settled, |_| false)?;
+/// The steady jet on a wall of `scene`: the world the grains are released into.
+pub fn settled_jet(scene: &RcScene) -> Result<World, SimError> {
+    let mut world =
+        jet_wall_world_cfl(scene.across, scene.jet_speed_m_s, Fluid::water(), scene.cfl)?;
+    let t_b = JET_B / scene.jet_speed_m_s;
+    world.run_until(scene.release_at_b_over_v * t_b, |_| false)?;
     Ok(world)
 }
 
@@ -241,7 +240,8 @@ const TOL_COINCIDE: f64 = 0.05;
 
 /// The scene of the coupling-radius study: the jet's particles across its width [`JET_B`], its
 /// speed, the grain's speed at release over the jet's (the paper gives neither speed: its
-/// Table 4 is not in its text), and the porosity of the Ergun/Wen–Yu drag switch (eq. 44).
+/// Table 4 is not in its text), the porosity of the Ergun/Wen–Yu drag switch (eq. 44), the
+/// Courant number of the steps and when the first grain leaves.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RcScene {
     /// Particles across the jet.
@@ -252,18 +252,32 @@ pub struct RcScene {
     pub release_ratio: f64,
     /// The porosity at and below which the unresolved grain's drag is Ergun's (eq. 44).
     pub switch_porosity: f64,
+    /// Courant number C_F of the steps (the water jet's 0.2 unless a fine jet needs less).
+    pub cfl: f64,
+    /// Time from the jet's start to the first release, in transit times b/v (its head reaches
+    /// the wall at 2).
+    pub release_at_b_over_v: f64,
 }
 
 impl RcScene {
-    /// A scene with the paper's drag switch (ε = 0.8).
+    /// A scene with the paper's drag switch (ε = 0.8), stepped at the water jet's CFL 0.2.
     pub fn new(across: usize, jet_speed_m_s: f64, release_ratio: f64) -> Self {
         Self {
             across,
             jet_speed_m_s,
             release_ratio,
             switch_porosity: DEFAULT_SWITCH_POROSITY,
+            cfl: Self::DEFAULT_CFL,
+            release_at_b_over_v: Self::DEFAULT_RELEASE_AT,
         }
     }
+
+    /// The first release once the jet has settled: [`SETTLE_B_OVER_V`] after its head reaches
+    /// the wall.
+    pub const DEFAULT_RELEASE_AT: f64 = NOZZLE_HEIGHT_B + SETTLE_B_OVER_V;
+
+    /// The water jet's Courant number (`Settings::water_jet`).
+    pub const DEFAULT_CFL: f64 = Settings::WATER_JET_CFL;
 
     /// The grain's speed at release (m/s).
     pub fn release_speed(&self) -> f64 {
@@ -279,23 +293,14 @@ impl RcScene {
         if self.switch_porosity != DEFAULT_SWITCH_POROSITY {
             s += &format!(", switch {}", self.switch_porosity);
         }
+        if self.cfl != Self::DEFAULT_CFL {
+            s += &format!(", CFL {}", self.cfl);
+        }
+        if self.release_at_b_over_v != Self::DEFAULT_RELEASE_AT {
+            s += &format!(", released at {} b/v", self.release_at_b_over_v);
+        }
         s
     }
-}
-
-/// Grains released into one settled jet of `scene`: an unresolved grain per coupling radius
-/// of `factors` (in grain diameters), then, if `resolved`, a fully resolved one
-/// ([`ride_resolved`]).
-pub fn rides(scene: &RcScene, factors: &[f64], resolved: bool) -> Result<Vec<GrainRide>, SimError> {
-    let jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
-    let mut rides = factors
-        .iter()
-        .map(|&f| ride(&jet, scene, f))
-        .collect::<Result<Vec<_>, _>>()?;
-    if resolved {
-        rides.push(ride_resolved(&jet, scene.release_speed())?);
-    }
-    Ok(rides)
 }
 
 /// Releases per coupling radius in the study's rows, one transit time b/v apart in the same
@@ -303,29 +308,37 @@ pub fn rides(scene: &RcScene, factors: &[f64], resolved: bool) -> Result<Vec<Gra
 /// unsteadiness (docs/jet.md#one-grain-in-the-jet), so the rows judge means over releases.
 pub const RC_RELEASES: usize = 3;
 
-/// The rides of [`RC_RELEASES`] releases into the settled jet of `scene`, one transit time
-/// b/v apart, each a ride per coupling radius of `factors`: `[release][factor]`.
-pub fn release_series(scene: &RcScene, factors: &[f64]) -> Result<Vec<Vec<GrainRide>>, SimError> {
-    let mut jet = settled_jet(scene.across, scene.jet_speed_m_s)?;
+/// `releases` releases into the settled jet of `scene`, one transit time b/v apart, each an
+/// unresolved grain per coupling radius of `factors` (in grain diameters) and, if `resolved`,
+/// a fully resolved one ([`ride_resolved`]) last: `[release][ride]`.
+pub fn release_series(
+    scene: &RcScene,
+    factors: &[f64],
+    resolved: bool,
+    releases: usize,
+) -> Result<Vec<Vec<GrainRide>>, SimError> {
+    let mut jet = settled_jet(scene)?;
     let t_b = JET_B / scene.jet_speed_m_s;
-    let mut out = Vec::with_capacity(RC_RELEASES);
-    for k in 0..RC_RELEASES {
+    let mut out = Vec::with_capacity(releases);
+    for k in 0..releases {
         if k > 0 {
             let t = jet.time() + t_b;
             jet.run_until(t, |_| false)?;
         }
-        out.push(
-            factors
-                .iter()
-                .map(|&f| ride(&jet, scene, f))
-                .collect::<Result<Vec<_>, _>>()?,
-        );
+        let mut rides = factors
+            .iter()
+            .map(|&f| ride(&jet, scene, f))
+            .collect::<Result<Vec<_>, _>>()?;
+        if resolved {
+            rides.push(ride_resolved(&jet, scene.release_speed())?);
+        }
+        out.push(rides);
     }
     Ok(out)
 }
 
 /// Mean and sample standard deviation (n − 1; 0 for one value) of `v`.
-fn mean_std(v: &[f64]) -> (f64, f64) {
+pub fn mean_std(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
     let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0).max(1.0);
@@ -337,7 +350,7 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
 /// miss it: docs/jet.md#one-grain-in-the-jet), whether the means at 2.5 d and 3.0 d coincide,
 /// and the chart of the first release's grains.
 pub fn rc_study(scene: RcScene) -> Result<CaseReport, SimError> {
-    let series = release_series(&scene, &RC_FACTORS)?;
+    let series = release_series(&scene, &RC_FACTORS, false, RC_RELEASES)?;
     let mut rep = CaseReport::default();
     let mut contact = Vec::new();
     let releases = format!("mean of {RC_RELEASES} releases 1 b/v apart");

@@ -74,6 +74,9 @@ impl Default for Settings {
 }
 
 impl Settings {
+    /// The water-jet paper's Courant number C_F (its eq. 51).
+    pub const WATER_JET_CFL: f64 = 0.2;
+
     /// The water-jet paper's numerics (seed 002, docs/jet.md): cubic spline at h = 1.25 Δx,
     /// Courant number C_F = 0.2, no density filter, the solid phase's artificial viscosity
     /// α = β = 1.0, at spacing `spacing_m` under `gravity_m_s2`.
@@ -82,7 +85,7 @@ impl Settings {
             spacing_m,
             h_over_dx: 1.25,
             kernel: KernelKind::CubicSpline,
-            cfl: 0.2,
+            cfl: Self::WATER_JET_CFL,
             gravity_m_s2,
             shepard_interval: 0,
             solid_viscosity: Some(ArtificialViscosity::SOLID),
