@@ -131,9 +131,15 @@ fn the_coupling_radius_study_rides_a_grain_and_refuses_bad_scenes() {
         .map(|x| x.as_f64().unwrap())
         .collect();
     assert_eq!(each.len(), 2);
-    assert!((speed - 0.5 * (each[0] + each[1])).abs() < 1e-9 * speed, "{each:?}");
+    assert!(
+        (speed - 0.5 * (each[0] + each[1])).abs() < 1e-9 * speed,
+        "{each:?}"
+    );
     let std = rides[0]["contact_speed_std_m_s"].as_f64().unwrap();
-    assert!((std - (each[0] - each[1]).abs() / 2f64.sqrt()).abs() < 1e-9 * speed, "{std}");
+    assert!(
+        (std - (each[0] - each[1]).abs() / 2f64.sqrt()).abs() < 1e-9 * speed,
+        "{std}"
+    );
     // On its way in it was faster the farther from the wall, and at 0.125 d from contact
     // already near its contact speed.
     let before = rides[0]["speed_before_contact"].as_array().unwrap();
