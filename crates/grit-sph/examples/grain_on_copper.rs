@@ -6,8 +6,10 @@
 //! does for the whole jet.
 //!
 //! ```sh
-//! cargo run --release -p grit-sph --example grain_on_copper -- SPACING_M SPEED_M_S
+//! cargo run --release -p grit-sph --example grain_on_copper -- SPACING_M SPEED_M_S [CHI]
 //! ```
+//!
+//! CHI is the penalty contact's overlap coefficient χ (default 0.5, the jet scene's).
 
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
@@ -25,6 +27,7 @@ fn arg<T: std::str::FromStr>(k: usize, name: &str, default: T) -> Result<T, Stri
 fn main() -> Result<(), String> {
     let dx = arg(1, "SPACING_M", 1e-4)?;
     let speed = arg(2, "SPEED_M_S", 150.0)?;
+    let chi = arg(3, "CHI", PenaltyParams::default().chi)?;
     let e = |e: grit_sph::InputError| e.to_string();
     let (width, depth, r) = (2e-3, 1e-3, 1e-4);
     let mut w = World::new(Settings::water_jet(dx, Vector::zeros())).map_err(e)?;
@@ -55,7 +58,10 @@ fn main() -> Result<(), String> {
     w.set_abrasives(Abrasives::new(
         dem,
         CouplingParams::default(),
-        PenaltyParams::default(),
+        PenaltyParams {
+            chi,
+            ..PenaltyParams::default()
+        },
         None,
     ))
     .map_err(e)?;
@@ -95,7 +101,7 @@ fn main() -> Result<(), String> {
     let d_max = p.damage.iter().cloned().fold(0.0, f64::max);
     let grain = &w.abrasives().ok_or("no grains")?.dem.grains[0];
     println!(
-        "spacing {dx:e} m, grain at {speed} m/s, {} particles, 3 µs: highest pressure {:.2} GPa, lowest {:.2} GPa (at {:.2} µs, x = {:.1} y = {:.1} µm, grain centre then {:.1} µm above the surface), largest eps_p {:.3}, largest D {:.3}, D gained in tension {:.4}, in compression {:.4}, grain's speed after {:.1} m/s upwards",
+        "spacing {dx:e} m, grain at {speed} m/s, chi {chi}, {} particles, 3 µs: highest pressure {:.2} GPa, lowest {:.2} GPa (at {:.2} µs, x = {:.1} y = {:.1} µm, grain centre then {:.1} µm above the surface), largest eps_p {:.3}, largest D {:.3}, D gained in tension {:.4}, in compression {:.4}, grain's speed after {:.1} m/s upwards",
         p.len(),
         p_max * 1e-9,
         p_min * 1e-9,
