@@ -1,4 +1,4 @@
-//! Where the jet's target damage comes from (docs/jet.md, "Why the first loss comes early"):
+//! Where the jet's target damage comes from (docs/jet.md, "What removes the first mass"):
 //! after every step, each target particle's gain in Johnson–Cook damage D and in plastic strain
 //! is booked as tensile when its stress triaxiality −p/σ_eq is positive after the step, else as
 //! compressive. Per slice it prints the target's totals, and for every particle deleted at
