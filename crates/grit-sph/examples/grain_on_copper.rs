@@ -6,13 +6,14 @@
 //! does for the whole jet.
 //!
 //! ```sh
-//! cargo run --release -p grit-sph --example grain_on_copper -- SPACING_M SPEED_M_S [CHI] [NUMERICS]
+//! cargo run --release -p grit-sph --example grain_on_copper -- SPACING_M SPEED_M_S [CHI] [NUMERICS] [FRICTION]
 //! ```
 //!
 //! CHI is the penalty contact's overlap coefficient χ (default 0.5, the jet scene's). NUMERICS
 //! is `jet` (the jet scene's, `Settings::water_jet`; the default), `jet-shepard` (the same with
 //! the impact scene's Shepard density filter every 40 steps) or `impact` (the impact scene's
 //! `Settings::default()`: quintic kernel, h = 1.3 Δx, the filter, no artificial viscosity).
+//! FRICTION is the contact's Coulomb μ (default 0.3, the jet scene's).
 
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
@@ -32,6 +33,7 @@ fn main() -> Result<(), String> {
     let speed = arg(2, "SPEED_M_S", 150.0)?;
     let chi = arg(3, "CHI", PenaltyParams::default().chi)?;
     let numerics = arg(4, "NUMERICS", "jet".to_string())?;
+    let friction = arg(5, "FRICTION", PenaltyParams::default().friction)?;
     let settings = match numerics.as_str() {
         "jet" => Settings::water_jet(dx, Vector::zeros()),
         "jet-shepard" => Settings {
@@ -78,10 +80,7 @@ fn main() -> Result<(), String> {
     w.set_abrasives(Abrasives::new(
         dem,
         CouplingParams::default(),
-        PenaltyParams {
-            chi,
-            ..PenaltyParams::default()
-        },
+        PenaltyParams { chi, friction },
         None,
     ))
     .map_err(e)?;
@@ -121,7 +120,7 @@ fn main() -> Result<(), String> {
     let d_max = p.damage.iter().cloned().fold(0.0, f64::max);
     let grain = &w.abrasives().ok_or("no grains")?.dem.grains[0];
     println!(
-        "spacing {dx:e} m, grain at {speed} m/s, chi {chi}, {numerics} numerics, {} particles, 3 µs: highest pressure {:.2} GPa, lowest {:.2} GPa (at {:.2} µs, x = {:.1} y = {:.1} µm, grain centre then {:.1} µm above the surface), largest eps_p {:.3}, largest D {:.3}, D gained in tension {:.4}, in compression {:.4}, grain's speed after {:.1} m/s upwards",
+        "spacing {dx:e} m, grain at {speed} m/s, chi {chi}, friction {friction}, {numerics} numerics, {} particles, 3 µs: highest pressure {:.2} GPa, lowest {:.2} GPa (at {:.2} µs, x = {:.1} y = {:.1} µm, grain centre then {:.1} µm above the surface), largest eps_p {:.3}, largest D {:.3}, D gained in tension {:.4}, in compression {:.4}, grain's speed after {:.1} m/s upwards",
         p.len(),
         p_max * 1e-9,
         p_min * 1e-9,
