@@ -131,11 +131,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             let rides = &series[0];
             // Per ride: the mean and standard deviation of its releases' contact speeds.
             let stats: Vec<(Vec<f64>, f64, f64)> = (0..rides.len())
-                .map(|k| {
-                    let v: Vec<f64> = series.iter().map(|s| s[k].contact_speed_m_s).collect();
-                    let (mean, std) = jet_grain::mean_std(&v);
-                    (v, mean, std)
-                })
+                .map(|k| jet_grain::contact_speeds(&series, k))
                 .collect();
             if let Some(path) = &chart {
                 super::plot::line_chart(&jet_grain::rides_chart(&scene, rides), path)?;

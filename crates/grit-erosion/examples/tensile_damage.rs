@@ -13,6 +13,7 @@ use std::collections::HashMap;
 
 use grit_erosion::jet::{JetParams, JetRun};
 use grit_sph::particles::von_mises;
+use grit_sph::physics::triaxiality;
 use grit_sph::World;
 
 /// Argument `k` (`name`), or `default` when it is not given.
@@ -53,8 +54,7 @@ impl Books {
         for i in (0..p.len()).filter(|&i| p.body[i] == self.target) {
             let mut h = self.live.get(&p.id[i]).copied().unwrap_or_default();
             let (dd, de) = (p.damage[i] - h.damage, p.eps_p[i] - h.eps_p);
-            let seq = von_mises(&p.sdev[i]);
-            if seq > 0.0 && -pressure[i] / seq > 0.0 {
+            if triaxiality(pressure[i], von_mises(&p.sdev[i])) > 0.0 {
                 h.damage_tension += dd;
                 h.eps_tension += de;
                 self.slice_tension += dd;

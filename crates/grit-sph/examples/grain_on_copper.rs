@@ -18,6 +18,7 @@
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
 use grit_sph::particles::von_mises;
+use grit_sph::physics::triaxiality;
 use grit_sph::{Abrasives, Material, Motion, PenaltyParams, Settings, Vector, World};
 
 /// Argument `k` (`name`), or `default` when it is not given.
@@ -101,8 +102,7 @@ fn main() -> Result<(), String> {
         let pressure = w.pressures();
         for i in 0..p.len() {
             let dd = p.damage[i] - d_prev[i];
-            let seq = von_mises(&p.sdev[i]);
-            if seq > 0.0 && -pressure[i] / seq > 0.0 {
+            if triaxiality(pressure[i], von_mises(&p.sdev[i])) > 0.0 {
                 tension += dd;
             } else {
                 compression += dd;

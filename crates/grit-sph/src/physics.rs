@@ -176,6 +176,17 @@ pub fn radial_return_at(
 /// particle fails within a few steps of plastic flow instead of at once.
 pub const MIN_FRACTURE_STRAIN: f64 = 1e-3;
 
+/// Stress triaxiality σ* = −p/σ_eq of eq. 20 from the pressure `pressure` and the von Mises
+/// stress `seq` (0 where σ_eq is 0); positive in tension.
+#[inline]
+pub fn triaxiality(pressure: f64, seq: f64) -> f64 {
+    if seq > 0.0 {
+        -pressure / seq
+    } else {
+        0.0
+    }
+}
+
 /// Johnson–Cook fracture strain (eq. 20) for triaxiality σ* = −p/σ_eq, plastic strain rate and
 /// temperature; the rate logarithm is held at 0 below ε̇0f as in eq. 18.
 pub fn fracture_strain(

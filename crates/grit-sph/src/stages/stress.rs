@@ -119,7 +119,7 @@ pub(crate) fn stress(
                             if let Some(Fracture::JohnsonCook(dm)) = &mat.damage {
                                 let seq = von_mises(&r.sdev);
                                 let pr = c.pressure(*rho, rho0, en);
-                                let triax = if seq > 0.0 { -pr / seq } else { 0.0 };
+                                let triax = physics::triaxiality(pr, seq);
                                 let ef = physics::fracture_strain(dm, jc, triax, *epr, *temp);
                                 *dmg += r.d_eps / ef;
                             }

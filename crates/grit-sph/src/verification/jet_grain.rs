@@ -338,11 +338,19 @@ pub fn release_series(
 }
 
 /// Mean and sample standard deviation (n − 1; 0 for one value) of `v`.
-pub fn mean_std(v: &[f64]) -> (f64, f64) {
+fn mean_std(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
     let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0).max(1.0);
     (mean, var.sqrt())
+}
+
+/// Ride `k`'s contact speed in each release of `series` (from [`release_series`]), with
+/// their mean and sample standard deviation.
+pub fn contact_speeds(series: &[Vec<GrainRide>], k: usize) -> (Vec<f64>, f64, f64) {
+    let v: Vec<f64> = series.iter().map(|r| r[k].contact_speed_m_s).collect();
+    let (mean, std) = mean_std(&v);
+    (v, mean, std)
 }
 
 /// The study's rows on `scene`: the mean contact speed over [`RC_RELEASES`] releases at each
@@ -355,8 +363,7 @@ pub fn rc_study(scene: RcScene) -> Result<CaseReport, SimError> {
     let mut contact = Vec::new();
     let releases = format!("mean of {RC_RELEASES} releases 1 b/v apart");
     for (k, f) in RC_FACTORS.into_iter().enumerate() {
-        let speeds: Vec<f64> = series.iter().map(|r| r[k].contact_speed_m_s).collect();
-        let (v, sd) = mean_std(&speeds);
+        let (speeds, v, sd) = contact_speeds(&series, k);
         contact.push(v);
         let err = (v - PAPER_CONTACT_SPEED).abs() / PAPER_CONTACT_SPEED;
         let judged = (f - 2.0).abs() < 1e-9;
