@@ -9,7 +9,7 @@
 //! wall particles' surface; the grain meets the water only through the coupling.
 
 use super::jet_wall::{jet_wall_world_cfl, JET_B, NOZZLE_HEIGHT_B};
-use super::{fail, CaseReport, Chart, Row, Series};
+use super::{fail, fail_at, CaseReport, Chart, Row, Series};
 use crate::coupling::{CouplingParams, DEFAULT_SWITCH_POROSITY};
 use crate::dem::{Dem, DemParams, Grain, Wall};
 use crate::error::SimError;
@@ -100,9 +100,10 @@ fn follow(
     loop {
         w.step()?;
         let Some((pos, vel)) = grain(&w) else {
-            return Err(fail(format!(
-                "jet_grain: the grain left the scene ({label})"
-            )));
+            return Err(fail_at(
+                &w,
+                format!("jet_grain: the grain left the scene ({label})"),
+            ));
         };
         trace.0.push((w.time() - t0) * 1e6);
         trace.1.push(-vel.y);
@@ -116,10 +117,18 @@ fn follow(
             });
         }
         if w.time() > t_max {
-            return Err(fail(format!(
-                "jet_grain: no contact within {:.2e} s ({label})",
-                t_max - t0
-            )));
+            let closest = to_contact_m.iter().copied().fold(f64::INFINITY, f64::min);
+            return Err(fail_at(
+                &w,
+                format!(
+                    "jet_grain: no contact within {:.2e} s ({label}): the grain came no closer \
+                     than {:.1} µm to contact and moves at {:.1} m/s, stopped or swept aside \
+                     by the water",
+                    t_max - t0,
+                    closest * 1e6,
+                    vel.norm()
+                ),
+            ));
         }
     }
 }

@@ -25,6 +25,15 @@ pub(crate) fn fail(what: String) -> crate::error::SimError {
     }
 }
 
+/// A failure found while stepping `w`, at its step and time.
+pub(crate) fn fail_at(w: &crate::world::World, what: String) -> crate::error::SimError {
+    crate::error::SimError {
+        step: w.steps(),
+        time_s: w.time(),
+        what,
+    }
+}
+
 /// One line of the verification table. Field names are read by scripts: keep them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
