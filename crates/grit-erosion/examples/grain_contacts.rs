@@ -8,29 +8,15 @@
 //! cargo run --release -p grit-erosion --example grain_contacts -- SEED RELEASE_RATIO SPACING_M
 //! ```
 
-use grit_erosion::jet::{JetParams, JetRun};
+mod common;
 
-/// Argument `k` (`name`), or `default` when it is not given.
-fn arg<T: std::str::FromStr>(k: usize, name: &str, default: T) -> Result<T, String> {
-    std::env::args().nth(k).map_or(Ok(default), |s| {
-        s.parse()
-            .map_err(|_| format!("{name}: not a number: {s:?}"))
-    })
-}
+use common::{arg, short_run};
 
 fn main() -> Result<(), String> {
     let seed = arg(1, "SEED", 1u64)?;
     let ratio = arg(2, "RELEASE_RATIO", 1.0)?;
     let spacing = arg(3, "SPACING_M", 1e-4)?;
-    let params = JetParams {
-        time_ms: 0.2,
-        slice_ms: 0.05,
-        grain_speed_ratio: ratio,
-        spacing_m: spacing,
-        ..JetParams::default()
-    };
-    params.validate().map_err(|e| e.to_string())?;
-    let mut run = JetRun::new(params, seed).map_err(|e| e.to_string())?;
+    let mut run = short_run(seed, ratio, spacing)?;
     println!("seed {seed}, release at {ratio} of the jet's speed, spacing {spacing} m");
     println!("slice  contact starts   rms |v| (m/s)  sum v² (m²/s²)  grain-steps in contact  first touches  loss (g/m)");
     while !run.finished() {

@@ -9,7 +9,9 @@
 //! cargo run --release -p grit-erosion --example grain_porosity -- SEED [RELEASE_RATIO] [SPACING_M]
 //! ```
 
-use grit_erosion::jet::{JetParams, JetRun};
+mod common;
+
+use common::{arg, short_run};
 use grit_sph::coupling;
 use grit_sph::World;
 
@@ -18,14 +20,6 @@ const EVERY: u64 = 10;
 /// Height bands above the target's initial surface, in grain diameters: in the crater or at
 /// the surface, the stagnation zone, the free jet.
 const BANDS_D: [f64; 3] = [1.0, 5.0, f64::INFINITY];
-
-/// Argument `k` (`name`), or `default` when it is not given.
-fn arg<T: std::str::FromStr>(k: usize, name: &str, default: T) -> Result<T, String> {
-    std::env::args().nth(k).map_or(Ok(default), |s| {
-        s.parse()
-            .map_err(|_| format!("{name}: not a number: {s:?}"))
-    })
-}
 
 /// The porosities ε_i sampled in one height band.
 #[derive(Default, Clone)]
@@ -87,15 +81,7 @@ fn main() -> Result<(), String> {
     let seed = arg(1, "SEED", 1u64)?;
     let ratio = arg(2, "RELEASE_RATIO", 1.0)?;
     let spacing = arg(3, "SPACING_M", 1e-4)?;
-    let params = JetParams {
-        time_ms: 0.2,
-        slice_ms: 0.05,
-        grain_speed_ratio: ratio,
-        spacing_m: spacing,
-        ..JetParams::default()
-    };
-    params.validate().map_err(|e| e.to_string())?;
-    let mut run = JetRun::new(params, seed).map_err(|e| e.to_string())?;
+    let mut run = short_run(seed, ratio, spacing)?;
     let surface_y = run.layout().surface_y_m;
     let switch = run
         .world()

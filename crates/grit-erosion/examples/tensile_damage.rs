@@ -11,18 +11,12 @@
 
 use std::collections::HashMap;
 
-use grit_erosion::jet::{JetParams, JetRun};
+mod common;
+
+use common::{arg, short_run};
 use grit_sph::particles::von_mises;
 use grit_sph::physics::triaxiality;
 use grit_sph::World;
-
-/// Argument `k` (`name`), or `default` when it is not given.
-fn arg<T: std::str::FromStr>(k: usize, name: &str, default: T) -> Result<T, String> {
-    std::env::args().nth(k).map_or(Ok(default), |s| {
-        s.parse()
-            .map_err(|_| format!("{name}: not a number: {s:?}"))
-    })
-}
 
 /// One target particle's history: damage and plastic strain now, their gains in tension and in
 /// compression, and the lowest pressure it saw (Pa).
@@ -81,14 +75,8 @@ impl Books {
 fn main() -> Result<(), String> {
     let seed = arg(1, "SEED", 1u64)?;
     let spacing = arg(2, "SPACING_M", 1e-4)?;
-    let params = JetParams {
-        time_ms: 0.2,
-        slice_ms: 0.05,
-        spacing_m: spacing,
-        ..JetParams::default()
-    };
-    params.validate().map_err(|e| e.to_string())?;
-    let mut run = JetRun::new(params, seed).map_err(|e| e.to_string())?;
+    // Grains released at the jet's speed, the scene's default.
+    let mut run = short_run(seed, 1.0, spacing)?;
     let mut books = Books {
         target: run.layout().target_body as u32,
         live: HashMap::new(),
