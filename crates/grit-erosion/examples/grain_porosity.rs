@@ -12,8 +12,8 @@
 mod common;
 
 use common::{arg, short_run};
-use grit_sph::coupling;
-use grit_sph::World;
+use grit_sph::coupling::{self, FluidView};
+use grit_sph::{Vector, World};
 
 /// Steps between samples: a grain crosses a spacing in about ten steps at the jet's speed.
 const EVERY: u64 = 10;
@@ -46,35 +46,57 @@ impl Band {
     }
 }
 
-/// Each grain's ε_i and its height above `surface_y` (m), as the coupling stage computes ε_i.
-fn grain_porosities(w: &World, surface_y: f64) -> Vec<(f64, f64)> {
+/// Each grain's ε_i and its height above `surface_y` (m): the coupling's own Shepard average
+/// (`coupling::coupling_forces`' `grain_fluid`), from the porosity and pairs the coupling
+/// stage finds at these positions. Grains with no fluid within R_c are left out.
+fn grain_porosities(w: &World, surface_y: f64) -> Result<Vec<(f64, f64)>, String> {
     let Some(ab) = w.abrasives() else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
     let Some(fb) = ab.fluid_body else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
+    let fluid_props = w.bodies()[fb]
+        .fluid()
+        .ok_or("the coupled body is not a fluid")?;
     let p = w.particles();
     let fluid: Vec<usize> = (0..p.len()).filter(|&i| p.body[i] as usize == fb).collect();
-    let pos: Vec<_> = fluid.iter().map(|&i| p.pos[i]).collect();
+    let gather_v = |a: &[Vector]| -> Vec<Vector> { fluid.iter().map(|&i| a[i]).collect() };
+    let gather_s = |a: &[f64]| -> Vec<f64> { fluid.iter().map(|&i| a[i]).collect() };
+    let (pos, vel, mass, rho_bar) = (
+        gather_v(&p.pos),
+        gather_v(&p.vel),
+        gather_s(&p.mass),
+        gather_s(&p.rho),
+    );
     let grains = &ab.dem.grains;
-    let Ok(pairs) = coupling::find_pairs(&ab.coupling, &pos, grains) else {
-        return Vec::new();
-    };
+    let e = |e: grit_sph::InputError| e.to_string();
+    let pairs = coupling::find_pairs(&ab.coupling, &pos, grains).map_err(e)?;
     let eps = coupling::porosity(&ab.coupling, fluid.len(), grains, &pairs).values;
-    let mut sum = vec![(0.0, 0.0); grains.len()];
-    for q in &pairs {
-        let i = fluid[q.fluid];
-        let vw = p.mass[i] / p.rho[i] * q.w;
-        sum[q.grain].0 += vw;
-        sum[q.grain].1 += eps[q.fluid] * vw;
-    }
-    grains
+    // The porosity does not depend on θ; the forces computed beside it are not used.
+    let theta = vec![Vector::zeros(); fluid.len()];
+    let view = FluidView {
+        position: &pos,
+        velocity: &vel,
+        mass: &mass,
+        rho_bar: &rho_bar,
+    };
+    let f = coupling::coupling_forces(
+        &ab.coupling,
+        fluid_props,
+        view,
+        &eps,
+        &theta,
+        grains,
+        &pairs,
+    )
+    .map_err(e)?;
+    Ok(grains
         .iter()
-        .zip(&sum)
-        .filter(|(_, s)| s.0 > 0.0)
-        .map(|(g, s)| (s.1 / s.0, g.pos.y - surface_y))
-        .collect()
+        .zip(&f.grain_fluid)
+        .filter(|(_, gf)| gf.shepard > 0.0)
+        .map(|(g, gf)| (gf.porosity, g.pos.y - surface_y))
+        .collect())
 }
 
 fn main() -> Result<(), String> {
@@ -93,31 +115,37 @@ fn main() -> Result<(), String> {
         "seed {seed}, release at {ratio} of the jet's speed, spacing {spacing} m; grains sampled every {EVERY} steps"
     );
     println!("slice  band (height above the surface)     samples  on Ergun's side   porosity");
+    let d = run.params().grain_diameter_m;
     let mut total = vec![Band::default(); BANDS_D.len()];
     while !run.finished() {
         let mut bands = vec![Band::default(); BANDS_D.len()];
         let mut steps = 0u64;
+        let mut failed = None;
         let mut observe = |w: &World| {
             steps += 1;
-            if !steps.is_multiple_of(EVERY) {
+            if failed.is_some() || !steps.is_multiple_of(EVERY) {
                 return;
             }
-            let d = w
-                .abrasives()
-                .and_then(|a| a.dem.grains.first())
-                .map_or(2e-4, |g| 2.0 * g.radius_m);
-            for (eps, height) in grain_porosities(w, surface_y) {
-                let b = BANDS_D
-                    .iter()
-                    .position(|&top| height < top * d)
-                    .unwrap_or(0);
-                bands[b].eps.push(eps);
+            match grain_porosities(w, surface_y) {
+                Ok(found) => {
+                    for (eps, height) in found {
+                        let b = BANDS_D
+                            .iter()
+                            .position(|&top| height < top * d)
+                            .unwrap_or(0);
+                        bands[b].eps.push(eps);
+                    }
+                }
+                Err(e) => failed = Some(e),
             }
         };
         let s = run
             .run_next_slice_observed(&|| false, Some(&mut observe))
             .map_err(|e| e.to_string())?
             .ok_or("the slice was cancelled")?;
+        if let Some(e) = failed {
+            return Err(e);
+        }
         let slice = s.slice;
         for (k, b) in bands.iter_mut().enumerate() {
             total[k].eps.extend_from_slice(&b.eps);
