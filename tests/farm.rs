@@ -254,6 +254,7 @@ async fn auth_validation_size_and_unknown_ids() {
     let http = reqwest::Client::new();
     let api = format!("{}/api/v1", coord.url);
     let status = |r: reqwest::Response| r.status().as_u16();
+    let status_of = |r: &reqwest::Response| r.status().as_u16();
 
     // 401: no token, a wrong token, or the other role's token.
     let r = http.get(format!("{api}/campaigns")).send().await.unwrap();
@@ -323,10 +324,75 @@ async fn auth_validation_size_and_unknown_ids() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("shapes[0]"));
 
-    // 413 above the body limit (64 KiB in these tests).
+    // 413 above the body limit (64 KiB in these tests), in the API's error body.
     let big = format!(r#"{{"name": "{}"}}"#, "x".repeat(100_000));
     let r = post(big).await.unwrap();
-    assert_eq!(status(r), 413);
+    assert_eq!(status_of(&r), 413);
+    assert!(r.json::<Value>().await.unwrap()["error"].is_string());
+    // The framework's own refusals come as JSON too: a method the path does not take (405,
+    // naming those it does), a query the endpoint does not take (422 naming it).
+    let r = http
+        .put(format!("{api}/campaigns"))
+        .bearer_auth(SUBMIT)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status_of(&r), 405);
+    let allow = r.headers()["allow"].to_str().unwrap().to_string();
+    assert!(allow.contains("GET") && allow.contains("POST"), "{allow}");
+    let body: Value = r.json().await.unwrap();
+    assert!(body["error"].as_str().unwrap().contains("Allow"), "{body}");
+    for (query, field) in [("raw=maybe", "raw"), ("rwa=true", "rwa")] {
+        let r = http
+            .get(format!(
+                "{api}/campaigns/{}/results?{query}",
+                Uuid::new_v4()
+            ))
+            .bearer_auth(SUBMIT)
+            .send()
+            .await
+            .unwrap();
+        assert_eq!(status_of(&r), 422, "{query}");
+        assert_eq!(r.json::<Value>().await.unwrap()["field"], field);
+    }
+    // Worker bodies: the field named; an empty worker name refused; JSON types only.
+    let claim = |body: Value| {
+        http.post(format!("{api}/worker/claim"))
+            .bearer_auth(WORKER)
+            .json(&body)
+            .send()
+    };
+    for body in [
+        serde_json::json!({"worker": 5}),
+        serde_json::json!({"worker": ""}),
+    ] {
+        let r = claim(body.clone()).await.unwrap();
+        assert_eq!(status_of(&r), 422, "{body}");
+        assert_eq!(
+            r.json::<Value>().await.unwrap()["field"],
+            "worker",
+            "{body}"
+        );
+    }
+    let r = http
+        .post(format!("{api}/worker/claim"))
+        .bearer_auth(WORKER)
+        .header("content-type", "text/plain")
+        .body(r#"{"worker": "w"}"#)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status_of(&r), 415);
+    assert!(r.json::<Value>().await.unwrap()["error"].is_string());
+    let r = http
+        .post(format!("{api}/worker/jobs/abc/heartbeat"))
+        .bearer_auth(WORKER)
+        .json(&serde_json::json!({"lease_id": Uuid::new_v4()}))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status_of(&r), 404);
+    assert!(r.json::<Value>().await.unwrap()["error"].is_string());
 
     // 404 for unknown ids and jobs.
     let c = submitter(&coord.url);

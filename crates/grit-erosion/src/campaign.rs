@@ -51,6 +51,57 @@ pub use plan::{
 pub const MIN_IMPACTS: u32 = 21;
 /// Most jobs one campaign may expand into; a guard against a typo that would flood the queue.
 pub const MAX_JOBS: usize = 1_000_000;
+/// Most impacts one sample may be planned with (fixed, or `until_steady.max`): about a week of
+/// one core at the seed's resolution, a guard against a typo that would hold a worker for years.
+pub const MAX_IMPACTS: u32 = 100_000;
+/// Most values one list of a spec may hold (angles, shapes, each swept field): the product of
+/// the lists is the cell count, which must stay countable and checkable at submission.
+pub const MAX_LIST: usize = 1_000;
+
+/// The rule every list of a spec keeps: at most [`MAX_LIST`] values.
+fn check_list_len(field: &str, len: usize) -> Result<(), SpecError> {
+    if len > MAX_LIST {
+        return Err(err(
+            field,
+            format!("lists {len} values, more than the limit of {MAX_LIST}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The rules of one swept field: at least one value, each finite and > 0 (≥ 0 where not
+/// `positive`), none twice, at most [`MAX_LIST`]. A field of one value is named without index.
+fn check_sweep(name: &str, values: &[f64], positive: bool) -> Result<(), SpecError> {
+    if values.is_empty() {
+        return Err(err(name, "must give at least one value"));
+    }
+    check_list_len(name, values.len())?;
+    for (i, v) in values.iter().enumerate() {
+        let field = if values.len() > 1 {
+            format!("{name}[{i}]")
+        } else {
+            name.to_string()
+        };
+        if !v.is_finite() || *v < 0.0 || (positive && *v <= 0.0) {
+            let rule = if positive { "> 0" } else { "≥ 0" };
+            return Err(err(
+                field,
+                format!("must be a finite number {rule}, got {v}"),
+            ));
+        }
+        if values[..i].contains(v) {
+            return Err(err(field, format!("{v} listed twice")));
+        }
+    }
+    Ok(())
+}
+
+/// Jobs a campaign of these list lengths and samples per cell expands into, without overflow.
+fn job_count(lengths: impl IntoIterator<Item = usize>, samples: u32) -> u128 {
+    lengths
+        .into_iter()
+        .fold(samples as u128, |n, len| n.saturating_mul(len as u128))
+}
 
 /// A rejected campaign spec: `field` is the path of the offending value, `rule` what it broke.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -372,6 +423,9 @@ impl CampaignSpec {
         if self.angles_deg.is_empty() {
             return Err(err("angles_deg", "must list at least one angle"));
         }
+        check_list_len("angles_deg", self.angles_deg.len())?;
+        check_list_len("shapes", self.shapes.len())?;
+        check_list_len("material", self.material.values().len())?;
         for (i, a) in self.angles_deg.iter().enumerate() {
             if !(*a > 0.0 && *a <= 90.0) {
                 return Err(err(
@@ -431,6 +485,12 @@ impl CampaignSpec {
                         format!("no entry for angle {a} and no \"default\""),
                     ))
                 }
+                Some(ImpactPlan::Fixed(n)) if n > MAX_IMPACTS => {
+                    return Err(err(
+                        field,
+                        format!("must be at most {MAX_IMPACTS} impacts per sample, got {n}"),
+                    ))
+                }
                 Some(ImpactPlan::Fixed(n)) if n < min => {
                     return Err(err(
                         field,
@@ -454,32 +514,12 @@ impl CampaignSpec {
             ("distribution_range_dg", self.distribution_range_dg.values()),
         ];
         for (name, values) in sweeps {
-            if values.is_empty() {
-                return Err(err(name, "must give at least one value"));
-            }
-            let positive = name != "distribution_range_dg";
-            for (i, v) in values.iter().enumerate() {
-                let field = if values.len() > 1 {
-                    format!("{name}[{i}]")
-                } else {
-                    name.to_string()
-                };
-                if !v.is_finite() || (positive && *v <= 0.0) || *v < 0.0 {
-                    let rule = if positive { "> 0" } else { "≥ 0" };
-                    return Err(err(
-                        field,
-                        format!("must be a finite number {rule}, got {v}"),
-                    ));
-                }
-                if values[..i].contains(v) {
-                    return Err(err(field, format!("{v} listed twice")));
-                }
-            }
+            check_sweep(name, values, name != "distribution_range_dg")?;
         }
         if self.material.values().is_empty() {
             return Err(err("material", "must give at least one material"));
         }
-        let jobs = self.cell_count() as u128 * self.samples.max() as u128;
+        let jobs = job_count(self.dims().map(|(_, n)| n), self.samples.max());
         if jobs > MAX_JOBS as u128 {
             return Err(err(
                 "samples",
@@ -497,21 +537,10 @@ impl CampaignSpec {
         Ok(())
     }
 
-    fn cell_count(&self) -> usize {
-        self.angles_deg.len()
-            * self.shapes.len()
-            * self.velocity_m_s.0.len()
-            * self.grain.diameter_m.0.len()
-            * self.grain.density_kg_m3.0.len()
-            * self.spacing_m.0.len()
-            * self.distribution_range_dg.0.len()
-            * self.material.0.len()
-    }
-
-    /// Per swept dimension: (spec field, index of this cell's value, whether swept). Order
-    /// is slowest first, the reverse of the mixed-radix digits of the cell index.
-    fn sweep_indices(&self, cell: u32) -> Vec<(&'static str, usize, bool)> {
-        let dims: [(&'static str, usize); 8] = [
+    /// Each swept dimension's spec field and length, in the mixed-radix order of the cell
+    /// index (fastest digit first).
+    fn dims(&self) -> [(&'static str, usize); 8] {
+        [
             ("angles_deg", self.angles_deg.len()),
             ("shapes", self.shapes.len()),
             ("velocity_m_s", self.velocity_m_s.0.len()),
@@ -520,9 +549,20 @@ impl CampaignSpec {
             ("spacing_m", self.spacing_m.0.len()),
             ("distribution_range_dg", self.distribution_range_dg.0.len()),
             ("material", self.material.0.len()),
-        ];
+        ]
+    }
+
+    /// Cells of a validated spec (its job count is bounded, so the product fits).
+    fn cell_count(&self) -> usize {
+        self.dims().iter().map(|(_, n)| n).product()
+    }
+
+    /// Per swept dimension: (spec field, index of this cell's value, whether swept), in the
+    /// mixed-radix digits of the cell index.
+    fn sweep_indices(&self, cell: u32) -> Vec<(&'static str, usize, bool)> {
         let mut rest = cell as usize;
-        dims.iter()
+        self.dims()
+            .iter()
             .map(|(name, n)| {
                 let i = rest % n;
                 rest /= n;
@@ -786,6 +826,77 @@ mod tests {
         );
         assert_eq!(field_of("[1, 2]"), "(campaign)");
         assert_eq!(field_of("{"), "(json)");
+    }
+
+    /// The rule of a rejected spec.
+    fn rule_of(json: &str) -> String {
+        parse(json)
+            .and_then(|s| s.validate().map(|_| s))
+            .expect_err("must be rejected")
+            .rule
+    }
+
+    #[test]
+    fn sizes_that_would_flood_the_queue_or_a_worker_are_refused() {
+        let list = |n: usize, from: f64| -> String {
+            let v: Vec<String> = (0..n).map(|i| format!("{}", from + i as f64)).collect();
+            format!("[{}]", v.join(","))
+        };
+        // More values in one list than a spec may hold.
+        let json = format!(r#"{{"velocity_m_s": {}}}"#, list(MAX_LIST + 1, 1.0));
+        assert_eq!(field_of(&json), "velocity_m_s");
+        assert!(rule_of(&json).contains("more than the limit of 1000"));
+        // Lists whose product passes the 64-bit range (2^64 wraps a usize product to zero):
+        // counted in full and refused.
+        let values =
+            |n: usize, scale: f64| -> Vec<f64> { (1..=n).map(|i| i as f64 * scale).collect() };
+        let tri =
+            |name: &str| serde_json::json!({"name": name, "vertices_m": [[0, 0], [1, 0], [0, 1]]});
+        let json = serde_json::json!({
+            "angles_deg": values(1000, 0.09),
+            "shapes": ["octagon", "hexagon", "square", "rectangle", "circle", tri("a"), tri("b")],
+            "material": ["aisi304", "copper", "al6061"],
+            "samples": 1,
+            "velocity_m_s": values(1000, 0.1),
+            "grain": {"diameter_m": values(1000, 1e-6), "density_kg_m3": values(1000, 1.0)},
+            "spacing_m": values(1000, 1e-8),
+            "distribution_range_dg": values(1000, 1e-3),
+        })
+        .to_string();
+        let rule = rule_of(&json);
+        assert!(
+            rule.contains(&format!("expands into {} jobs", 21 * 10u128.pow(18))),
+            "{rule}"
+        );
+        assert_eq!(field_of(r#"{"impacts": 100001}"#), "impacts");
+        assert_eq!(
+            field_of(r#"{"impacts": {"until_steady": {"min": 30, "max": 100001, "step": 5}}}"#),
+            "impacts.until_steady.max"
+        );
+        assert_eq!(
+            field_of(r#"{"impacts": {"until_steady": {"min": 30, "max": 40, "step": 41}}}"#),
+            "impacts.until_steady.step"
+        );
+        // The scene's own bounds, through the cells.
+        assert_eq!(field_of(r#"{"settle_fraction": 2}"#), "settle_fraction");
+        assert_eq!(field_of(r#"{"velocity_m_s": 1e300}"#), "velocity_m_s");
+        assert_eq!(
+            field_of(r#"{"grain": {"density_kg_m3": 1e6}}"#),
+            "grain.density_kg_m3"
+        );
+        for json in [
+            r#"{"spacing_m": 1e-12}"#,
+            r#"{"surface_width_dg": 1e6}"#,
+            r#"{"grain": {"diameter_m": 1}}"#,
+        ] {
+            assert_eq!(field_of(json), "spacing_m", "{json}");
+            assert!(rule_of(json).contains("particles"), "{json}");
+        }
+        // The seed's finest scene stays well inside.
+        parse(r#"{"spacing_m": 7.8125e-6, "velocity_m_s": 1000}"#)
+            .unwrap()
+            .validate()
+            .unwrap();
     }
 
     #[test]

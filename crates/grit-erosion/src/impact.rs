@@ -223,6 +223,14 @@ impl Default for ImpactParams {
 /// support (3h = 3.9 Δx), so free particles never see a truncated kernel there.
 const FIXED_LAYERS: f64 = 4.0;
 
+/// Fastest grain the impact scene takes (m/s): erosion speeds, with room above the seed's 100.
+pub const MAX_VELOCITY_M_S: f64 = 1000.0;
+/// Densest grain the impact scene takes (kg/m³): above osmium, the densest element.
+pub const MAX_DENSITY_KG_M3: f64 = 25_000.0;
+/// Most particles a surface may hold: a guard against a typo in the spacing or the surface
+/// size that would exhaust a worker's memory (the seed's scene has about 6 000).
+pub const MAX_SURFACE_PARTICLES: f64 = 5e5;
+
 /// Fewest particle layers a surface may have: fixed layers below, free layers between, and as
 /// many again for the impact to work in.
 pub const MIN_SURFACE_LAYERS: f64 = 3.0 * FIXED_LAYERS;
@@ -266,6 +274,33 @@ impl ImpactParams {
         positive("surface_width_dg", self.surface_width_dg)?;
         positive("surface_depth_dg", self.surface_depth_dg)?;
         positive("settle_fraction", self.settle_fraction)?;
+        if self.settle_fraction >= 1.0 {
+            return Err(InputError::new(
+                "settle_fraction",
+                format!(
+                    "is a fraction of the grain's kinetic energy and must be below 1, got {}",
+                    InputError::shown(self.settle_fraction)
+                ),
+            ));
+        }
+        if self.velocity_m_s > MAX_VELOCITY_M_S {
+            return Err(InputError::new(
+                "velocity_m_s",
+                format!(
+                    "must be at most {MAX_VELOCITY_M_S} m/s (solid particle erosion; the seed's grains fly at 100 m/s), got {}",
+                    InputError::shown(self.velocity_m_s)
+                ),
+            ));
+        }
+        if self.grain_density_kg_m3 > MAX_DENSITY_KG_M3 {
+            return Err(InputError::new(
+                "grain_density_kg_m3",
+                format!(
+                    "must be at most {MAX_DENSITY_KG_M3} kg/m³ (denser than any solid), got {}",
+                    InputError::shown(self.grain_density_kg_m3)
+                ),
+            ));
+        }
         if self.grain_diameter_m / self.spacing_m < 6.0 {
             return Err(InputError::new(
                 "spacing_m",
@@ -305,6 +340,16 @@ impl ImpactParams {
                 ),
             ));
         }
+        let ppd = self.grain_diameter_m / self.spacing_m;
+        let particles = self.surface_width_dg * self.surface_depth_dg * ppd * ppd;
+        if particles > MAX_SURFACE_PARTICLES {
+            return Err(InputError::new(
+                "spacing_m",
+                format!(
+                    "gives a surface of {particles:.3e} particles (surface_width_dg × surface_depth_dg × (grain_diameter_m / spacing_m)²), more than the limit of {MAX_SURFACE_PARTICLES:.0e}; the seed's scene has about 6 000"
+                ),
+            ));
+        }
         self.material
             .validate()
             .map_err(|e| InputError::new(format!("material.{}", e.field), e.rule))?;
@@ -328,6 +373,13 @@ impl ImpactParams {
     /// abscissa of the erosion curve.
     pub fn grain_mass_kg_m(&self) -> f64 {
         self.grain_density_kg_m3 * std::f64::consts::PI * self.grain_diameter_m.powi(2) / 4.0
+    }
+
+    /// Surface mass per unit depth (kg/m): density × width × depth, the most any sample can
+    /// lose (seed section 4's surface).
+    pub fn surface_mass_kg_m(&self) -> f64 {
+        let dg = self.grain_diameter_m;
+        self.material.density_kg_m3 * self.surface_width_dg * dg * self.surface_depth_dg * dg
     }
 
     /// Engine settings for this scene (seed sections 2–3 defaults at this spacing).

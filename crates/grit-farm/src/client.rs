@@ -60,6 +60,7 @@ pub struct Client {
     http: reqwest::Client,
     base: String,
     token: Secret,
+    timeout: Duration,
 }
 
 impl Client {
@@ -81,10 +82,16 @@ impl Client {
             .timeout(request_timeout)
             .build()
             .map_err(|e| ClientError::Unreachable(e.to_string()))?;
+        if !(base.starts_with("http://") || base.starts_with("https://")) {
+            return Err(ClientError::Unreachable(format!(
+                "the coordinator URL must start with http:// or https://, got {base:?}"
+            )));
+        }
         Ok(Client {
             http,
             base: base.trim_end_matches('/').to_string(),
             token,
+            timeout: request_timeout,
         })
     }
 
@@ -104,12 +111,25 @@ impl Client {
         }
     }
 
+    /// Why a request got no answer, in words: a timeout says how long it waited.
+    fn unreachable(&self, e: reqwest::Error) -> ClientError {
+        ClientError::Unreachable(if e.is_timeout() {
+            format!(
+                "{}: no answer within {} s",
+                self.base,
+                self.timeout.as_secs_f64()
+            )
+        } else {
+            format!("{}: {e}", self.base)
+        })
+    }
+
     async fn send(&self, rb: reqwest::RequestBuilder) -> Result<reqwest::Response, ClientError> {
         let resp = self
             .auth(rb)
             .send()
             .await
-            .map_err(|e| ClientError::Unreachable(e.to_string()))?;
+            .map_err(|e| self.unreachable(e))?;
         if resp.status().is_success() {
             return Ok(resp);
         }

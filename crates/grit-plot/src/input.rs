@@ -104,7 +104,7 @@ pub fn parse(text: &str) -> Result<PlotInput, PlotError> {
     };
     if obj.get("scene").and_then(Value::as_str) == Some("jet") {
         return Err(bad(
-            "a jet campaign's results (scene: jet), not an impact campaign's: grit plot draws              them one file at a time"
+            "a jet campaign's results (scene: jet), not an impact campaign's: they are drawn one file at a time"
                 .into(),
         ));
     }
@@ -125,6 +125,33 @@ pub fn parse(text: &str) -> Result<PlotInput, PlotError> {
     let raw = obj.remove("raw");
     let results: CampaignResults = serde_json::from_value(value)
         .map_err(|e| bad(format!("not a results file grit can read: {e}")))?;
+    // A file edited by hand or by another tool: values no campaign can produce would draw
+    // and compare as NaN.
+    for (i, c) in results.cells.iter().enumerate() {
+        if !(c.angle_deg > 0.0 && c.angle_deg <= 90.0) {
+            return Err(bad(format!(
+                "cells[{i}].angle_deg: must be in (0, 90] degrees, got {}",
+                c.angle_deg
+            )));
+        }
+        let checks = [
+            ("erosion_mean", c.erosion_mean, false),
+            ("erosion_std", c.erosion_std, true),
+            ("erosion_sem", c.erosion_sem, true),
+        ];
+        for (name, v, non_negative) in checks {
+            if let Some(v) = v {
+                if !v.is_finite() || (non_negative && v < 0.0) {
+                    let rule = if non_negative {
+                        "finite and ≥ 0"
+                    } else {
+                        "finite"
+                    };
+                    return Err(bad(format!("cells[{i}].{name}: must be {rule}, got {v}")));
+                }
+            }
+        }
+    }
     let raw: Option<Vec<RawSeries>> = match raw {
         None | Some(Value::Null) => None,
         Some(r) => Some(serde_json::from_value(r).map_err(|e| bad(format!("raw: {e}")))?),

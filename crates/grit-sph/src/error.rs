@@ -21,6 +21,16 @@ impl InputError {
         }
     }
 
+    /// A number as an error message quotes it: plain between 1e-3 and 1e6, in exponent form
+    /// outside, so a typo of 1e308 does not print three hundred digits.
+    pub fn shown(v: f64) -> String {
+        if v == 0.0 || !v.is_finite() || (1e-3..1e6).contains(&v.abs()) {
+            format!("{v}")
+        } else {
+            format!("{v:e}")
+        }
+    }
+
     /// Checks the rule most physical inputs share: a finite number > 0 (errors name the field and
     /// the rule: docs/design.md#rules-the-engine-keeps).
     pub fn require_positive(field: impl Into<String>, v: f64) -> Result<(), InputError> {
@@ -29,7 +39,7 @@ impl InputError {
         } else {
             Err(InputError::new(
                 field,
-                format!("must be a finite number > 0, got {v}"),
+                format!("must be a finite number > 0, got {}", InputError::shown(v)),
             ))
         }
     }

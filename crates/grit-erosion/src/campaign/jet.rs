@@ -18,7 +18,9 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use super::json::{self, count, field_path, reject_unknown};
-use super::{err, job_seed, MaterialSpec, SpecError, Sweep, MAX_JOBS};
+use super::{
+    check_list_len, check_sweep, err, job_count, job_seed, MaterialSpec, SpecError, Sweep, MAX_JOBS,
+};
 use crate::jet::JetParams;
 
 /// The AWJ paper's jet speed coefficient: v_jet = 0.7 √(2P/ρ_w).
@@ -248,6 +250,7 @@ impl JetCampaignSpec {
         ]
     }
 
+    /// Cells of a validated spec (its job count is bounded, so the product fits).
     fn cell_count(&self) -> usize {
         self.dims().iter().map(|(_, n)| n).product()
     }
@@ -301,31 +304,13 @@ impl JetCampaignSpec {
             ("slice_ms", std::slice::from_ref(&self.slice_ms), true),
         ];
         for (name, values, positive) in sweeps {
-            if values.is_empty() {
-                return Err(err(name, "must give at least one value"));
-            }
-            for (i, v) in values.iter().enumerate() {
-                let field = if values.len() > 1 {
-                    format!("{name}[{i}]")
-                } else {
-                    name.to_string()
-                };
-                if !v.is_finite() || *v < 0.0 || (positive && *v <= 0.0) {
-                    let rule = if positive { "> 0" } else { "≥ 0" };
-                    return Err(err(
-                        field,
-                        format!("must be a finite number {rule}, got {v}"),
-                    ));
-                }
-                if values[..i].contains(v) {
-                    return Err(err(field, format!("{v} listed twice")));
-                }
-            }
+            check_sweep(name, values, positive)?;
         }
+        check_list_len("material", self.material.values().len())?;
         if self.material.values().is_empty() {
             return Err(err("material", "must give at least one material"));
         }
-        let jobs = self.cell_count() as u128 * self.samples as u128;
+        let jobs = job_count(self.dims().map(|(_, n)| n), self.samples);
         if jobs > MAX_JOBS as u128 {
             return Err(err(
                 "samples",
@@ -591,6 +576,24 @@ mod tests {
         );
         let e = parse(r#""samples": 0"#).unwrap().validate().unwrap_err();
         assert!(e.rule.contains("at least 1"), "{e}");
+        // Sizes that would hold a worker for years or exhaust its memory.
+        assert_eq!(field_of(r#""velocity_m_s": 1e300"#), "velocity_m_s");
+        assert_eq!(field_of(r#""time_ms": 2000, "slice_ms": 1"#), "time_ms");
+        assert_eq!(
+            field_of(r#""spacing_m": 1e-7, "jet_width_m": 6e-4"#),
+            "spacing_m"
+        );
+        let e = parse(r#""time_ms": 1e12, "slice_ms": 1e-9"#)
+            .unwrap()
+            .validate()
+            .unwrap_err();
+        assert_eq!(e.field, "slice_ms");
+        assert!(e.rule.contains("1.0000e21 slices"), "{e}");
+        let many: Vec<String> = (1..=1001).map(|v| v.to_string()).collect();
+        assert_eq!(
+            field_of(&format!(r#""velocity_m_s": [{}]"#, many.join(","))),
+            "velocity_m_s"
+        );
         let e = parse(r#""time_ms": -1"#).unwrap().validate().unwrap_err();
         assert!(e.rule.contains("> 0"), "{e}");
         assert_eq!(

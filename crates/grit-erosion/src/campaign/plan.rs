@@ -9,7 +9,7 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::json::count;
-use super::{err, SpecError};
+use super::{err, SpecError, MAX_IMPACTS};
 use crate::aggregate::CellResult;
 
 /// Grow every sample of a cell by `step` impacts until the cell is steady or reaches `max`.
@@ -28,7 +28,8 @@ pub struct UntilSteady {
 }
 
 impl UntilSteady {
-    /// Checks `min ≥ least`, `max ≥ min`, `step ≥ 1`; `field` is where the rule sits.
+    /// Checks `min ≥ least`, `min ≤ max ≤ MAX_IMPACTS`, `1 ≤ step ≤ max`; `field` is where the
+    /// rule sits.
     pub fn validate(&self, field: &str, least: u32) -> Result<(), SpecError> {
         let at = |k: &str| format!("{field}.until_steady.{k}");
         if self.min < least {
@@ -43,8 +44,23 @@ impl UntilSteady {
                 format!("must be at least min ({}), got {}", self.min, self.max),
             ));
         }
+        if self.max > MAX_IMPACTS {
+            return Err(err(
+                at("max"),
+                format!(
+                    "must be at most {MAX_IMPACTS} impacts per sample, got {}",
+                    self.max
+                ),
+            ));
+        }
         if self.step == 0 {
             return Err(err(at("step"), "must be at least 1"));
+        }
+        if self.step > self.max {
+            return Err(err(
+                at("step"),
+                format!("must be at most max ({}), got {}", self.max, self.step),
+            ));
         }
         Ok(())
     }

@@ -104,6 +104,13 @@ impl Default for JetParams {
 
 /// Most slices one run may have: a guard against a typo that asks for years of steps.
 pub const MAX_SLICES: u32 = 100_000;
+/// Longest run (ms): past the seed's longest (60 ms), a guard against a typo in the units.
+pub const MAX_TIME_MS: f64 = 1000.0;
+/// Fastest jet (m/s): above any pump's (a 600 MPa pump gives about 770 m/s, AWJ eq. v = 0.7 √(2P/ρ)).
+pub const MAX_JET_SPEED_M_S: f64 = 2000.0;
+/// Most particles of the target and the jet's column: a guard against a spacing or size typo
+/// that would exhaust a worker's memory.
+pub const MAX_SCENE_PARTICLES: f64 = 5e5;
 
 impl JetParams {
     /// Checks every field; the error names the field and the rule.
@@ -139,7 +146,10 @@ impl JetParams {
         if !(self.mass_flow_kg_s.is_finite() && self.mass_flow_kg_s >= 0.0) {
             return Err(InputError::new(
                 "mass_flow_kg_s",
-                format!("must be a finite number >= 0, got {}", self.mass_flow_kg_s),
+                format!(
+                    "must be a finite number >= 0, got {}",
+                    InputError::shown(self.mass_flow_kg_s)
+                ),
             ));
         }
         self.dem.validate()?;
@@ -205,8 +215,36 @@ impl JetParams {
             return Err(InputError::new(
                 "slice_ms",
                 format!(
-                    "time_ms / slice_ms gives {} slices; at most {MAX_SLICES}",
-                    self.slices()
+                    "time_ms / slice_ms gives {:.4e} slices; at most {MAX_SLICES}",
+                    (self.time_ms / self.slice_ms).ceil()
+                ),
+            ));
+        }
+        if self.time_ms > MAX_TIME_MS {
+            return Err(InputError::new(
+                "time_ms",
+                format!(
+                    "must be at most {MAX_TIME_MS} ms (the seed's longest run is 60 ms), got {}",
+                    InputError::shown(self.time_ms)
+                ),
+            ));
+        }
+        if self.velocity_m_s > MAX_JET_SPEED_M_S {
+            return Err(InputError::new(
+                "velocity_m_s",
+                format!(
+                    "must be at most {MAX_JET_SPEED_M_S} m/s (abrasive water jets run at 300-900 m/s), got {}",
+                    InputError::shown(self.velocity_m_s)
+                ),
+            ));
+        }
+        let area = self.target_width_m * self.target_depth_m + self.jet_width_m * self.standoff_m;
+        let particles = area / (self.spacing_m * self.spacing_m);
+        if particles > MAX_SCENE_PARTICLES {
+            return Err(InputError::new(
+                "spacing_m",
+                format!(
+                    "gives {particles:.3e} particles in the target and the jet (target_width_m × target_depth_m + jet_width_m × standoff_m, over spacing_m²), more than the limit of {MAX_SCENE_PARTICLES:.0e}; the default scene has about 1 800"
                 ),
             ));
         }
@@ -221,6 +259,12 @@ impl JetParams {
             .map_err(|e| InputError::new(e.path().to_string(), e.inner().to_string()))?;
         p.validate()?;
         Ok(p)
+    }
+
+    /// Target mass per unit depth (kg/m): density × width × depth, the most a run can lose
+    /// (AWJ paper's target, reduced as `docs/jet.md` says).
+    pub fn target_mass_kg_m(&self) -> f64 {
+        self.material.0.density_kg_m3 * self.target_width_m * self.target_depth_m
     }
 
     /// Number of slices: ⌈T / slice⌉ (the last may be shorter).

@@ -414,10 +414,18 @@ impl SweepStudy {
     /// Checks the options and the scene; errors name the option or scene field.
     pub fn validate(&self) -> Result<(), StudyError> {
         let bad = |field: &str, rule: String| Err(InputError::new(field, rule).into());
-        if self.ppd.is_empty() || self.ppd.iter().any(|p| !(p.is_finite() && *p >= 6.0)) {
+        // The seed's finest is 32 per Dg; 128 is 16 times its particles and 4 times its steps.
+        let fine = |p: &f64| p.is_finite() && (6.0..=128.0).contains(p);
+        if self.ppd.is_empty() || !self.ppd.iter().all(fine) {
             return bad(
                 "--ppd",
-                "give resolutions of at least 6 particles per Dg".into(),
+                "give resolutions of 6 to 128 particles per Dg".into(),
+            );
+        }
+        if !self.variant_ppd.iter().all(fine) {
+            return bad(
+                "--variant-ppd",
+                "give resolutions of 6 to 128 particles per Dg".into(),
             );
         }
         if self.variants.is_empty() {

@@ -28,9 +28,10 @@ fn spec(impacts: &str, samples: &str) -> CampaignSpec {
     .unwrap()
 }
 
-/// Impact `k` (1-based) of a sample losing `loss(k)` × its grain mass.
-fn record(k: u32, loss: f64) -> ImpactRecord {
-    placeholder_record(k, 1e-4, loss * 1e-4)
+/// Impact `k` (1-based) of job `j`'s sample losing `loss` × its grain mass.
+fn record(j: &ClaimedJob, k: u32, loss: f64) -> ImpactRecord {
+    let grain = j.params.grain_mass_kg_m();
+    placeholder_record(k, grain, loss * grain)
 }
 
 /// A stand-in for the sample's state after its last impact.
@@ -43,7 +44,7 @@ fn checkpoint(j: &ClaimedJob) -> CheckpointBytes {
 async fn run_one(s: &Store, loss: impl Fn(u32, u32) -> f64) -> ClaimedJob {
     let j = s.claim("w").await.unwrap().expect("a queued job");
     let recs: Vec<ImpactRecord> = (j.impacts_done + 1..=j.impacts_planned)
-        .map(|k| record(k, loss(j.sample, k)))
+        .map(|k| record(&j, k, loss(j.sample, k)))
         .collect();
     let ckpt = j.extendable.then(|| checkpoint(&j));
     s.complete(j.job_id, j.lease_id, &recs, ckpt).await.unwrap();

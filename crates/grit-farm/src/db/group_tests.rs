@@ -10,8 +10,10 @@ use uuid::Uuid;
 
 use super::Store;
 
+/// Impact `k` of a sample of the campaign below (default grain), losing a little.
 fn record(k: u32) -> ImpactRecord {
-    crate::loadtest::placeholder_record(k, 1e-4, 1e-6)
+    let grain = grit_erosion::ImpactParams::default().grain_mass_kg_m();
+    crate::loadtest::placeholder_record(k, grain, 1e-6)
 }
 
 #[tokio::test]

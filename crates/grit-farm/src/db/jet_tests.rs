@@ -95,6 +95,19 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
         field(beat(vec![bad]).await.unwrap_err()),
         "slices[0].sample.t_s"
     );
+    // Past the run's time and a slice (3 µs + 1 µs), or more mass than the target holds.
+    let mut late = slice(3);
+    late.sample.t_s = 4.1e-6;
+    assert_eq!(
+        field(beat(vec![late]).await.unwrap_err()),
+        "slices[0].sample.t_s"
+    );
+    let mut heavy = slice(3);
+    heavy.sample.mass_loss_kg_m = 1e307;
+    assert_eq!(
+        field(beat(vec![heavy]).await.unwrap_err()),
+        "slices[0].sample.mass_loss_kg_m"
+    );
     let impacts = s
         .heartbeat(j.job_id, j.lease_id, &[placeholder()], None)
         .await;

@@ -8,6 +8,7 @@ use uuid::Uuid;
 
 use super::Store;
 use crate::api::{CampaignState, JobState};
+use crate::error::Error;
 
 const TINY: &str = r#"{"angles_deg": [90], "shapes": ["hexagon"], "samples": 2, "impacts": 2,
     "allow_short_samples": true, "spacing_m": 25e-6}"#;
@@ -207,8 +208,9 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
     )
     .unwrap();
     s.create_campaign(&spec, None).await.unwrap();
+    let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
     let records: Vec<_> = (1..=400)
-        .map(|k| placeholder_record(k, 1e-4 / 3.0, 1e-7 * f64::from(k).sqrt()))
+        .map(|k| placeholder_record(k, grain, 1e-7 * f64::from(k).sqrt()))
         .collect();
     let j = s.claim("w").await.unwrap().unwrap();
     let bytes: Vec<u8> = (0..=255).cycle().take(1000).collect();
@@ -252,4 +254,63 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
         .await
         .unwrap();
     assert_eq!(kept, 0, "a done job of a fixed plan keeps no checkpoint");
+}
+
+#[tokio::test]
+async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
+    use crate::loadtest::placeholder_record;
+
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let spec = CampaignSpec::from_json(TINY).unwrap();
+    s.create_campaign(&spec, None).await.unwrap();
+    let j = s.claim("w").await.unwrap().unwrap();
+    let grain = j.params.grain_mass_kg_m();
+    let refused = |rec| {
+        let s = &s;
+        let j = &j;
+        async move {
+            match s.heartbeat(j.job_id, j.lease_id, &[rec], None).await {
+                Err(Error::Invalid { field, .. }) => field,
+                other => panic!("expected a 422, got {other:?}"),
+            }
+        }
+    };
+    // A grain other than the cell's would put the sample's points at the wrong abscissa.
+    assert_eq!(
+        refused(placeholder_record(1, 1.7e308, 0.0)).await,
+        "impacts[0].grain_mass_kg"
+    );
+    assert_eq!(
+        refused(placeholder_record(1, grain * (1.0 + 1e-15), 0.0)).await,
+        "impacts[0].grain_mass_kg"
+    );
+    // Finite but more than the whole surface: its sums would overflow to infinity.
+    let surface = j.params.surface_mass_kg_m();
+    assert_eq!(
+        refused(placeholder_record(1, grain, 1e307)).await,
+        "impacts[0].mass_loss_kg"
+    );
+    assert_eq!(
+        refused(placeholder_record(1, grain, surface * 1.001)).await,
+        "impacts[0].mass_loss_kg"
+    );
+    let stored: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM impacts")
+        .fetch_one(&s.read)
+        .await
+        .unwrap();
+    assert_eq!(stored, 0, "nothing of a refused report is stored");
+    let beat = s
+        .heartbeat(
+            j.job_id,
+            j.lease_id,
+            &[placeholder_record(1, grain, surface)],
+            None,
+        )
+        .await
+        .unwrap();
+    assert_eq!(
+        beat.impacts_done, 1,
+        "the whole surface is the bound, and allowed"
+    );
 }

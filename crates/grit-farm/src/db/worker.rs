@@ -79,13 +79,11 @@ impl Leased {
     /// The claim's answer: the scene parsed and the checkpoint enveloped.
     fn claimed(self) -> Result<ClaimedJob> {
         let job_id = self.job_id;
-        let bad =
-            |e: serde_json::Error| Error::Internal(format!("stored params of job {job_id}: {e}"));
         let (params, jet) = if self.scene == "jet" {
-            let jet: JetParams = serde_json::from_str(&self.params).map_err(bad)?;
+            let jet: JetParams = stored_params(job_id, &self.params)?;
             (ImpactParams::default(), Some(jet))
         } else {
-            (serde_json::from_str(&self.params).map_err(bad)?, None)
+            (stored_params(job_id, &self.params)?, None)
         };
         Ok(ClaimedJob {
             job_id,
@@ -601,6 +599,8 @@ struct Held {
     has_checkpoint: bool,
     /// Whether the job runs the jet scene (its units are slices).
     jet: bool,
+    /// `cells.params`: the scene as JSON, which bounds the records a worker may send.
+    params: String,
 }
 
 impl Held {
@@ -628,7 +628,8 @@ async fn check_lease(
                 k.impacts_step AS impacts_step, k.samples_max AS samples_max,
                 k.target_sem_rel AS target_sem_rel,
                 EXISTS (SELECT 1 FROM checkpoints c WHERE c.job_id = j.id) AS has_checkpoint,
-                (SELECT p.scene FROM campaigns p WHERE p.id = j.campaign_id) AS scene
+                (SELECT p.scene FROM campaigns p WHERE p.id = j.campaign_id) AS scene,
+                k.params AS params
          FROM jobs j JOIN cells k ON k.campaign_id = j.campaign_id AND k.cell_index = j.cell_index
          WHERE j.id = ?",
     )
@@ -662,6 +663,7 @@ async fn check_lease(
         plan: CellPlan::from_row(&r),
         has_checkpoint: r.get("has_checkpoint"),
         jet: r.get::<&str, _>("scene") == "jet",
+        params: r.get("params"),
     })
 }
 
@@ -728,6 +730,12 @@ fn is_next(unit: &str, n: u32, done: u32, planned: u32, field: String) -> Result
     Ok(true)
 }
 
+/// The scene a job's cell stored at submission (`cells.params`).
+fn stored_params<T: serde::de::DeserializeOwned>(job_id: i64, params: &str) -> Result<T> {
+    serde_json::from_str(params)
+        .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))
+}
+
 /// Appends impacts after those stored; ones already stored are skipped (a resumed job
 /// re-runs impacts past its checkpoint, and a retried heartbeat resends). Every record is
 /// checked before any is written, and the new ones go in with one statement. Returns the
@@ -741,21 +749,35 @@ async fn store_impacts(
 ) -> Result<u32> {
     let mut done = held.done;
     let mut new = Vec::with_capacity(impacts.len());
+    let mut scene = None;
     for (i, rec) in impacts.iter().enumerate() {
         let field = |name: &str| format!("impacts[{i}].{name}");
         if !is_next("impact", rec.impact, done, held.planned, field("impact"))? {
             continue;
         }
-        if !(rec.grain_mass_kg.is_finite() && rec.grain_mass_kg > 0.0) {
+        let p = match &scene {
+            Some(p) => p,
+            None => scene.insert(stored_params::<ImpactParams>(job_id, &held.params)?),
+        };
+        // The worker computes the grain mass from these very params, so it matches to the bit.
+        let grain = p.grain_mass_kg_m();
+        if rec.grain_mass_kg.to_bits() != grain.to_bits() {
             return Err(Error::invalid(
                 field("grain_mass_kg"),
-                "must be finite and > 0",
+                format!(
+                    "must be the cell's grain mass {grain:e} kg/m, got {:e}",
+                    rec.grain_mass_kg
+                ),
             ));
         }
-        if !(rec.mass_loss_kg.is_finite() && rec.mass_loss_kg >= 0.0) {
+        let surface = p.surface_mass_kg_m();
+        if !(rec.mass_loss_kg.is_finite() && (0.0..=surface).contains(&rec.mass_loss_kg)) {
             return Err(Error::invalid(
                 field("mass_loss_kg"),
-                "must be finite and ≥ 0",
+                format!(
+                    "must be finite, ≥ 0 and at most the surface's mass {surface:e} kg/m, got {:e}",
+                    rec.mass_loss_kg
+                ),
             ));
         }
         new.push(rec);
@@ -790,18 +812,35 @@ async fn store_slices(
 ) -> Result<u32> {
     let mut done = held.done;
     let mut new = Vec::with_capacity(slices.len());
+    let mut scene = None;
     for (i, rec) in slices.iter().enumerate() {
         let field = |name: &str| format!("slices[{i}].{name}");
         if !is_next("slice", rec.slice, done, held.planned, field("slice"))? {
             continue;
         }
-        if !rec.t_s.is_finite() {
-            return Err(Error::invalid(field("sample.t_s"), "must be finite"));
+        let p = match &scene {
+            Some(p) => p,
+            None => scene.insert(stored_params::<JetParams>(job_id, &held.params)?),
+        };
+        // A slice ends at the first step past its end time: within a slice of it.
+        let end = (p.time_ms + p.slice_ms) * 1e-3;
+        if !(rec.t_s.is_finite() && (0.0..=end).contains(&rec.t_s)) {
+            return Err(Error::invalid(
+                field("sample.t_s"),
+                format!(
+                    "must be finite and in [0, {end:e}] s (the run's time and one slice), got {:e}",
+                    rec.t_s
+                ),
+            ));
         }
-        if !(rec.mass_loss_kg_m.is_finite() && rec.mass_loss_kg_m >= 0.0) {
+        let target = p.target_mass_kg_m();
+        if !(rec.mass_loss_kg_m.is_finite() && (0.0..=target).contains(&rec.mass_loss_kg_m)) {
             return Err(Error::invalid(
                 field("sample.mass_loss_kg_m"),
-                "must be finite and ≥ 0",
+                format!(
+                    "must be finite, ≥ 0 and at most the target's mass {target:e} kg/m, got {:e}",
+                    rec.mass_loss_kg_m
+                ),
             ));
         }
         new.push(rec);

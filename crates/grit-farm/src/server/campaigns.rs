@@ -9,7 +9,6 @@ use axum::http::{HeaderMap, StatusCode};
 use axum::routing::{get, post};
 use axum::{Json, Router};
 use grit_erosion::campaign::AnySpec;
-use serde::Deserialize;
 use uuid::Uuid;
 
 use super::{unknown_param, AppState};
@@ -112,23 +111,44 @@ async fn campaign_status(
     Ok(Json(s.store.status(campaign_id(&id)?).await?))
 }
 
-#[derive(Deserialize, utoipa::IntoParams)]
+/// Query of `GET /campaigns/{id}/results`.
+#[derive(utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 struct ResultsQuery {
-    /// Include every sample's per-impact series.
-    #[serde(default)]
+    /// Include every sample's per-impact series (`true` or `false`, default false).
     raw: bool,
+}
+
+impl ResultsQuery {
+    fn parse(q: &BTreeMap<String, String>) -> Result<ResultsQuery> {
+        let mut out = ResultsQuery { raw: false };
+        for (key, value) in q {
+            match key.as_str() {
+                "raw" => {
+                    out.raw = value.parse().map_err(|_| {
+                        Error::invalid("raw", format!("must be true or false, got {value:?}"))
+                    })?
+                }
+                other => return Err(unknown_param(other, "raw")),
+            }
+        }
+        Ok(out)
+    }
 }
 
 #[utoipa::path(get, path = "/api/v1/campaigns/{id}/results", params(("id" = Uuid, Path), ResultsQuery),
     responses((status = 200, body = AnyResults, description = "an impact campaign's ResultsResponse, or a jet campaign's JetResultsResponse (`scene: jet`)"),
-        (status = 401), (status = 404, body = ErrorBody)),
+        (status = 401), (status = 404, body = ErrorBody),
+        (status = 422, body = ErrorBody, description = "a bad `raw`, or an unknown parameter")),
     security(("submit_token" = [])))]
 async fn campaign_results(
     State(s): State<AppState>,
     Path(id): Path<String>,
-    Query(q): Query<ResultsQuery>,
+    Query(q): Query<BTreeMap<String, String>>,
 ) -> Result<Json<AnyResults>> {
-    Ok(Json(s.store.results_any(campaign_id(&id)?, q.raw).await?))
+    let id = campaign_id(&id)?;
+    let q = ResultsQuery::parse(&q)?;
+    Ok(Json(s.store.results_any(id, q.raw).await?))
 }
 
 /// Query of `GET /campaigns/{id}/jobs`.

@@ -123,6 +123,44 @@ async fn not_found() -> Error {
     Error::NotFound("route".into())
 }
 
+/// The API's JSON error body for the refusals the framework answers itself, which come as
+/// plain text or empty: 413 for a body over the limit, 405 for a method the path does not
+/// take, 400 for a query that does not parse. Status and headers stay.
+async fn json_errors(resp: axum::response::Response) -> axum::response::Response {
+    use axum::http::header::{CONTENT_LENGTH, CONTENT_TYPE};
+    use axum::response::IntoResponse;
+    let status = resp.status();
+    let json = resp
+        .headers()
+        .get(CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .is_some_and(|c| c.starts_with("application/json"));
+    if json || !(status.is_client_error() || status.is_server_error()) {
+        return resp;
+    }
+    let (mut parts, body) = resp.into_parts();
+    let text = axum::body::to_bytes(body, 64 << 10)
+        .await
+        .map(|b| String::from_utf8_lossy(&b).trim().to_string())
+        .unwrap_or_default();
+    let error = if !text.is_empty() {
+        text
+    } else if status == axum::http::StatusCode::METHOD_NOT_ALLOWED {
+        // The method router sets `Allow` outside this layer.
+        "method not allowed; the Allow header lists the methods this path takes".into()
+    } else {
+        status.canonical_reason().unwrap_or("error").to_lowercase()
+    };
+    parts.headers.remove(CONTENT_LENGTH);
+    parts.headers.remove(CONTENT_TYPE);
+    let mut out = Json(crate::api::ErrorBody { error, field: None }).into_response();
+    *out.status_mut() = status;
+    for (name, value) in &parts.headers {
+        out.headers_mut().insert(name.clone(), value.clone());
+    }
+    out
+}
+
 /// The whole service: the API under `/api/v1` and the dashboard page at `/`.
 pub fn app(state: AppState) -> Router {
     let submit = Router::new()
@@ -150,6 +188,7 @@ pub fn app(state: AppState) -> Router {
         .route("/healthz", get(healthz))
         .merge(crate::dashboard::router())
         .fallback(not_found)
+        .layer(middleware::map_response(json_errors))
         .layer(tower_http::trace::TraceLayer::new_for_http())
         .with_state(state)
 }

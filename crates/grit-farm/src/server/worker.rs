@@ -6,6 +6,7 @@
 //! `slices` where an impact job reports `impacts` (`JetHeartbeatRequest` and its kin), to the
 //! same endpoints; each body is read as the union of both forms.
 
+use axum::body::Bytes;
 use axum::extract::{FromRequest, Path, Request, State};
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
@@ -81,26 +82,65 @@ const CHECKPOINT_422: &str = "a value breaking a rule, `field` naming it; a chec
 (`checkpoint.job_id`), cut short (`checkpoint truncated`), damaged (`checkpoint checksum mismatch`) or \
 not a checkpoint of this job's scene and seed: nothing of the request was stored, impacts included";
 
-/// JSON body extractor whose rejections use the API's error body (status kept: 400 for
-/// syntax, 422 naming the field for a wrong value, 413 for too large, 415 for no JSON type).
+/// JSON body extractor whose rejections use the API's error body: 415 without a JSON content
+/// type, 413 for too large, 400 for malformed JSON, and 422 naming the field for a wrong value.
 pub struct ApiJson<T>(pub T);
+
+/// Whether a `Content-Type` names JSON: `application/json` or a `+json` type, any parameters.
+fn is_json(content_type: &str) -> bool {
+    let mime = content_type.split(';').next().unwrap_or("").trim();
+    mime.eq_ignore_ascii_case("application/json")
+        || (mime.len() > 5 && mime[mime.len() - 5..].eq_ignore_ascii_case("+json"))
+}
 
 impl<S, T> FromRequest<S> for ApiJson<T>
 where
-    Json<T>: FromRequest<S, Rejection = axum::extract::rejection::JsonRejection>,
+    T: serde::de::DeserializeOwned,
     S: Send + Sync,
 {
     type Rejection = Error;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, Error> {
-        match Json::<T>::from_request(req, state).await {
-            Ok(Json(v)) => Ok(ApiJson(v)),
-            Err(r) => Err(Error::BadRequest {
+        let json = req
+            .headers()
+            .get(axum::http::header::CONTENT_TYPE)
+            .and_then(|v| v.to_str().ok())
+            .is_some_and(is_json);
+        if !json {
+            return Err(Error::BadRequest {
+                status: StatusCode::UNSUPPORTED_MEDIA_TYPE,
+                message: "expected a body with Content-Type: application/json".into(),
+            });
+        }
+        let body = Bytes::from_request(req, state)
+            .await
+            .map_err(|r| Error::BadRequest {
                 status: r.status(),
                 message: r.body_text(),
-            }),
-        }
+            })?;
+        let de = &mut serde_json::Deserializer::from_slice(&body);
+        let value = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            if inner.is_data() && path != "." {
+                Error::invalid(path, inner.to_string())
+            } else if inner.is_data() {
+                Error::invalid("(body)", inner.to_string())
+            } else {
+                Error::BadRequest {
+                    status: StatusCode::BAD_REQUEST,
+                    message: format!("malformed JSON: {inner}"),
+                }
+            }
+        })?;
+        Ok(ApiJson(value))
     }
+}
+
+/// A job id from the path; one that is not an integer names no job (404).
+fn job_id(raw: &str) -> Result<i64> {
+    raw.parse()
+        .map_err(|_| Error::NotFound(format!("job {raw} (job ids are integers)")))
 }
 
 /// The bytes and checksum of `checkpoint` for the store, refused with a 422 naming the field
@@ -131,8 +171,8 @@ async fn check_checkpoint(
     responses((status = 200, body = ClaimedJob), (status = 204, description = "no job queued"), (status = 401)),
     security(("worker_token" = [])))]
 async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -> Result<Response> {
-    if req.worker.len() > 200 {
-        return Err(Error::invalid("worker", "must be at most 200 characters"));
+    if req.worker.is_empty() || req.worker.len() > 200 {
+        return Err(Error::invalid("worker", "must be 1 to 200 characters"));
     }
     Ok(match s.store.claim(&req.worker).await? {
         Some(job) => Json(job).into_response(),
@@ -149,9 +189,10 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
     security(("worker_token" = [])))]
 async fn heartbeat(
     State(s): State<AppState>,
-    Path(job): Path<i64>,
+    Path(job): Path<String>,
     ApiJson(mut req): ApiJson<Report>,
 ) -> Result<Json<HeartbeatResponse>> {
+    let job = job_id(&job)?;
     if req.error.is_some() {
         return Err(Report::refuse("error", "heartbeat"));
     }
@@ -170,9 +211,10 @@ async fn heartbeat(
     security(("worker_token" = [])))]
 async fn complete(
     State(s): State<AppState>,
-    Path(job): Path<i64>,
+    Path(job): Path<String>,
     ApiJson(mut req): ApiJson<Report>,
 ) -> Result<StatusCode> {
+    let job = job_id(&job)?;
     if req.error.is_some() {
         return Err(Report::refuse("error", "complete"));
     }
@@ -189,14 +231,18 @@ async fn complete(
     security(("worker_token" = [])))]
 async fn fail(
     State(s): State<AppState>,
-    Path(job): Path<i64>,
+    Path(job): Path<String>,
     ApiJson(req): ApiJson<Report>,
 ) -> Result<StatusCode> {
+    let job = job_id(&job)?;
     if req.checkpoint.is_some() {
         return Err(Report::refuse("checkpoint", "fail"));
     }
-    let Some(error) = req.error.as_deref() else {
-        return Err(Error::invalid("error", "missing: say what went wrong"));
+    let Some(error) = req.error.as_deref().filter(|e| !e.trim().is_empty()) else {
+        return Err(Error::invalid(
+            "error",
+            "missing or empty: say what went wrong",
+        ));
     };
     s.store
         .fail_with(job, req.lease_id, error, req.reported())
@@ -211,9 +257,10 @@ async fn fail(
     security(("worker_token" = [])))]
 async fn release(
     State(s): State<AppState>,
-    Path(job): Path<i64>,
+    Path(job): Path<String>,
     ApiJson(mut req): ApiJson<Report>,
 ) -> Result<StatusCode> {
+    let job = job_id(&job)?;
     if req.error.is_some() {
         return Err(Report::refuse("error", "release"));
     }

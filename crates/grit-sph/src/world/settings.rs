@@ -50,6 +50,11 @@ pub struct Settings {
 
 /// The largest Courant number `Settings` accepts.
 pub const MAX_CFL: f64 = 2.0;
+/// Smallest Courant number a scene may ask for: a hundred times more steps than the seed's
+/// 0.3 is a typo, not a setting.
+pub const MIN_CFL: f64 = 1e-3;
+/// Largest hourglass coefficient (eq. 16): 100 times the seed's 0.1.
+pub const MAX_HOURGLASS: f64 = 10.0;
 
 impl Default for Settings {
     fn default() -> Self {
@@ -101,11 +106,11 @@ impl Settings {
         pos("cfl", self.cfl)?;
         // Above 1 the step is unstable in every case `grit bench stability` maps; up to 2 is
         // allowed so that the map can show where.
-        if self.cfl > MAX_CFL {
+        if !(MIN_CFL..=MAX_CFL).contains(&self.cfl) {
             return Err(InputError::new(
                 "cfl",
                 format!(
-                    "must be at most {MAX_CFL} for an explicit step, got {}",
+                    "must lie in [{MIN_CFL}, {MAX_CFL}] for an explicit step, got {}",
                     self.cfl
                 ),
             ));
@@ -113,10 +118,13 @@ impl Settings {
         pos("skin_over_dx", self.skin_over_dx)?;
         pos("dt_max_s", self.dt_max_s)?;
         pos("temperature_k", self.temperature_k)?;
-        if !(self.hourglass.is_finite() && self.hourglass >= 0.0) {
+        if !(self.hourglass.is_finite() && (0.0..=MAX_HOURGLASS).contains(&self.hourglass)) {
             return Err(InputError::new(
                 "hourglass",
-                format!("must be >= 0, got {}", self.hourglass),
+                format!(
+                    "must lie in [0, {MAX_HOURGLASS}] (the seed's is 0.1), got {}",
+                    self.hourglass
+                ),
             ));
         }
         if !(self.taylor_quinney.is_finite() && (0.0..=1.0).contains(&self.taylor_quinney)) {
