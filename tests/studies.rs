@@ -154,15 +154,69 @@ fn sweep_runs_two_variants_resumes_and_charts() {
 fn studies_refuse_bad_input_naming_the_option() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 23] = [
         (
             &["bench", "impact", "--repeat", "0"],
             "--repeat: must be at least 1",
         ),
         (
             &["bench", "impact", "--threads", "0"],
-            "--threads: must be at least 1",
+            "'--threads <THREADS>': must be a whole number from 1 to 1024",
         ),
+        (
+            &["bench", "sweep", "--ppd", "16,1000", "--out", out],
+            "--ppd: give resolutions of 6 to 128",
+        ),
+        (
+            &["study", "settle", "--angle", "45", "--strict-fraction", "0.5"],
+            "--strict-fraction: must be > 0 and below the scene's settle_fraction 0.02",
+        ),
+        (
+            &["study", "rc", "--jet-speed-m-s", "1e5"],
+            "--jet-speed-m-s: must be > 0 and at most 2000",
+        ),
+        (
+            &["verify", "--only", "nosuchcase"],
+            "--only: `nosuchcase` is in no case group's name",
+        ),
+        (
+            &["sample", "--angle", "45", "--impacts", "1000000000"],
+            "must be a whole number from 1 to 100000",
+        ),
+        (
+            &["sample", "--angle", "45", "--spacing-m", "1e-9"],
+            "spacing_m: gives a surface of 3.750e11 particles",
+        ),
+        (
+            &["sample", "--angle", "45", "--velocity-m-s", "1e6"],
+            "velocity_m_s: must be at most 1000 m/s",
+        ),
+        (
+            &["sample", "--resume", "no-such.ckpt", "--angle", "30"],
+            "--angle: --resume runs the scene and seed stored in the checkpoint",
+        ),
+        (
+            &["sample", "--angle", "45", "--impacts", "2", "-o", "/proc/no/x.json"],
+            "--out /proc/no/x.json: cannot write there",
+        ),
+        (
+            &["jet", "--velocity-m-s", "1e308"],
+            "velocity_m_s: must be at most 2000 m/s (abrasive water jets run at 300-900 m/s), got 1e308",
+        ),
+        (
+            &["jet", "--time-ms", "1e308"],
+            "time_ms: must be at most 1000 ms",
+        ),
+        (&["work", "--poll-s", "1e20"], "must be a number of seconds > 0"),
+        (
+            &["serve", "--lease-ttl-s", "18446744073709551615"],
+            "must be a number of seconds > 0",
+        ),
+        (
+            &["run", "examples/quick.json", "--workers", "100000"],
+            "'--workers <WORKERS>': must be a whole number from 1 to 1024",
+        ),
+        (&["shapes", "--diameter-m", "1e300"], "--diameter-m: must lie in [1e-6, 1] m, got 1e300"),
         (
             &["bench", "stability", "--cfl", "0.3,3", "--out", out],
             "--cfl: 3",

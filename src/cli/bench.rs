@@ -31,10 +31,10 @@ enum BenchWhat {
     #[command(after_help = "Example: grit bench farm --clients 1,8 --seconds 5")]
     Farm {
         /// Concurrent clients, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = vec![1, 8, 64])]
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1, 8, 64], value_parser = crate::cli::thread_count)]
         clients: Vec<usize>,
         /// Seconds per client count.
-        #[arg(long, default_value_t = 5.0)]
+        #[arg(long, default_value_t = 5.0, value_parser = crate::cli::seconds)]
         seconds: f64,
         /// Folder for the scratch database.
         #[arg(long, default_value = "target/bench-farm")]
@@ -54,7 +54,7 @@ enum BenchWhat {
         #[command(flatten)]
         scene: ImpactScene,
         /// Threads of the timed run (1 is always timed too).
-        #[arg(long, default_value_t = 2)]
+        #[arg(long, default_value_t = 2, value_parser = crate::cli::thread_count)]
         threads: usize,
         /// Alternate the 1-thread and the N-thread run this many times and report medians.
         #[arg(long, default_value_t = 1)]
@@ -105,7 +105,7 @@ enum BenchWhat {
         #[arg(long, default_value = "out/stability")]
         out: PathBuf,
         /// Threads (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = crate::cli::thread_count)]
         threads: Option<usize>,
     },
 }
@@ -155,7 +155,7 @@ pub struct SweepArgs {
     #[arg(long)]
     resume: bool,
     /// Threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::thread_count)]
     threads: Option<usize>,
 }
 

@@ -26,16 +26,16 @@ pub struct RunArgs {
     pub campaign: PathBuf,
     /// Local workers (default: one per core, each with one engine thread, since samples
     /// are independent and parallelise better than the threads inside one impact).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::thread_count)]
     pub workers: Option<usize>,
     /// Engine threads per worker (default: cores / workers).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::thread_count)]
     pub threads: Option<usize>,
     /// Output folder: grit.db (resumable) and results.json.
     #[arg(long, default_value = "out/run")]
     pub out: PathBuf,
     /// Checkpoint every this many impacts.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = crate::cli::at_least_one)]
     pub checkpoint_every: u32,
     /// No progress bar.
     #[arg(long)]
@@ -63,10 +63,18 @@ pub struct Remote {
     pub token_file: Option<PathBuf>,
 }
 
+/// How long a client command waits for the coordinator's answer: a coordinator that accepts
+/// the connection and never answers fails the command instead of holding it.
+const COMMAND_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(60);
+
 impl Remote {
     fn client(self) -> anyhow::Result<Client> {
         let token = read_token(self.token, self.token_file, "token")?;
-        Ok(Client::new(&self.coordinator, token)?)
+        Ok(Client::with_timeout(
+            &self.coordinator,
+            token,
+            COMMAND_TIMEOUT,
+        )?)
     }
 }
 

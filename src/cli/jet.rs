@@ -11,7 +11,7 @@ use grit_erosion::jet::{JetParams, JetRun, JetSlice};
 use grit_sph::crater::CraterSample;
 use serde::Serialize;
 
-use super::output::{say, write_bytes, write_json};
+use super::output::{check_writable, say, write_bytes, write_json};
 use super::{pool, progress};
 
 mod snapshots;
@@ -48,7 +48,7 @@ pub struct JetArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Worker threads of the engine (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::thread_count)]
     threads: Option<usize>,
     /// Print the result as JSON on stdout.
     #[arg(long)]
@@ -122,6 +122,11 @@ impl JetArgs {
 
 /// Runs one jet with a progress bar over simulated time and prints its crater series.
 pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
+    for (flag, path) in [("--out", &a.out), ("--checkpoint", &a.checkpoint)] {
+        if let Some(path) = path {
+            check_writable(flag, path)?;
+        }
+    }
     let mut run = match &a.resume {
         Some(path) => {
             let bytes =

@@ -18,6 +18,56 @@ use anyhow::{bail, Context};
 use grit_farm::worker::Stop;
 use grit_farm::Secret;
 
+/// Most threads or local workers a command starts: more than any worker machine's cores,
+/// well below the system's limit on threads.
+pub const MAX_THREADS: usize = 1024;
+/// Longest time a seconds flag takes (about 116 days): any more is a typo in the units.
+pub const MAX_SECONDS: f64 = 1e7;
+
+/// Parser of `--threads` and `--workers`: a whole number from 1 to [`MAX_THREADS`].
+pub fn thread_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(format!("must be a whole number from 1 to {MAX_THREADS}")),
+    }
+}
+
+/// Parser of a duration flag: a finite number of seconds, > 0 and at most [`MAX_SECONDS`].
+pub fn seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_SECONDS => Ok(v),
+        _ => Err(format!(
+            "must be a number of seconds > 0 and at most {MAX_SECONDS:e}"
+        )),
+    }
+}
+
+/// Parser of a count that must be at least 1 (`--checkpoint-every`, `--max-attempts`).
+pub fn at_least_one(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("must be a whole number from 1 to {}", u32::MAX)),
+    }
+}
+
+/// Parser of an impact count: 1 to the most a sample may be planned with.
+pub fn impact_count(s: &str) -> Result<u32, String> {
+    use grit_erosion::campaign::MAX_IMPACTS;
+    match s.parse::<u32>() {
+        Ok(n) if (1..=MAX_IMPACTS).contains(&n) => Ok(n),
+        _ => Err(format!("must be a whole number from 1 to {MAX_IMPACTS}")),
+    }
+}
+
+/// Parser of a request-size limit: 1 KiB (the smallest request) to 4 GiB.
+pub fn body_bytes(s: &str) -> Result<usize, String> {
+    const MAX: usize = 4 << 30;
+    match s.parse::<usize>() {
+        Ok(n) if (1024..=MAX).contains(&n) => Ok(n),
+        _ => Err(format!("must be a number of bytes from 1024 to {MAX}")),
+    }
+}
+
 /// The rayon pool of `--threads`: that many threads, all cores when `None`.
 pub fn pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
     if threads == Some(0) {
@@ -80,12 +130,21 @@ pub fn read_token(
     file: Option<PathBuf>,
     flag: &str,
 ) -> anyhow::Result<Secret> {
+    // A token given but blank would silently mean "no token": refused instead.
+    let given = |t: String, what: String| {
+        if t.trim().is_empty() {
+            bail!("{what}: the token is empty");
+        }
+        Ok(Secret::new(Some(t)))
+    };
     match (value, file) {
         (Some(_), Some(_)) => bail!("give --{flag} or --{flag}-file, not both"),
-        (Some(v), None) => Ok(Secret::new(Some(v))),
-        (None, Some(p)) => std::fs::read_to_string(&p)
-            .map(|t| Secret::new(Some(t)))
-            .with_context(|| format!("--{flag}-file {}", p.display())),
+        (Some(v), None) => given(v, format!("--{flag}")),
+        (None, Some(p)) => {
+            let what = format!("--{flag}-file {}", p.display());
+            let t = std::fs::read_to_string(&p).with_context(|| what.clone())?;
+            given(t, what)
+        }
         (None, None) => Ok(Secret::default()),
     }
 }

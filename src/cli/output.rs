@@ -43,6 +43,22 @@ fn write_atomic(
     written.with_context(|| format!("writing {}", path.display()))
 }
 
+/// Fails now, naming `flag`, if `path` could not be written later: its folder must take the
+/// temporary file `write_atomic` writes there, so a long run does not end in a write error.
+pub fn check_writable(flag: &str, path: &Path) -> anyhow::Result<()> {
+    write_atomic(&probe_path(path)?, |_| Ok(()))
+        .and_then(|()| Ok(std::fs::remove_file(probe_path(path)?)?))
+        .with_context(|| format!("{flag} {}: cannot write there", path.display()))
+}
+
+/// A file beside `path` that nothing else uses, for `check_writable`.
+fn probe_path(path: &Path) -> anyhow::Result<std::path::PathBuf> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| anyhow!("{}: not a file name", path.display()))?;
+    Ok(path.with_file_name(format!(".{}.probe", name.to_string_lossy())))
+}
+
 /// Writes `bytes` to `path`, atomically.
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     write_atomic(path, |w| Ok(w.write_all(bytes)?))

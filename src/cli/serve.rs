@@ -27,10 +27,10 @@ pub struct ServeArgs {
     #[arg(long, env = "GRIT_LISTEN", default_value = "127.0.0.1:8080")]
     pub listen: String,
     /// Lease length in seconds; a worker that misses heartbeats this long loses its job.
-    #[arg(long, env = "GRIT_LEASE_TTL_S", default_value_t = 120.0)]
+    #[arg(long, env = "GRIT_LEASE_TTL_S", default_value_t = 120.0, value_parser = crate::cli::seconds)]
     pub lease_ttl_s: f64,
     /// Lost or failed leases after which a job stays failed.
-    #[arg(long, env = "GRIT_MAX_ATTEMPTS", default_value_t = 3)]
+    #[arg(long, env = "GRIT_MAX_ATTEMPTS", default_value_t = 3, value_parser = crate::cli::at_least_one)]
     pub max_attempts: u32,
     /// When a write is answered: `full` once flushed to the disk (survives a power loss), or
     /// `normal` once handed to the operating system (survives a killed coordinator, but an OS
@@ -50,10 +50,10 @@ pub struct ServeArgs {
     #[arg(long, env = "GRIT_WORKER_TOKEN_FILE")]
     pub worker_token_file: Option<PathBuf>,
     /// Largest campaign spec accepted, bytes (larger gets 413).
-    #[arg(long, default_value_t = server::DEFAULT_SUBMIT_LIMIT)]
+    #[arg(long, default_value_t = server::DEFAULT_SUBMIT_LIMIT, value_parser = crate::cli::body_bytes)]
     pub max_spec_bytes: usize,
     /// Largest worker request, bytes (heartbeats carry checkpoints).
-    #[arg(long, default_value_t = server::DEFAULT_WORKER_LIMIT)]
+    #[arg(long, default_value_t = server::DEFAULT_WORKER_LIMIT, value_parser = crate::cli::body_bytes)]
     pub max_worker_bytes: usize,
     /// Serve without tokens on a non-loopback address (anyone who can connect may submit
     /// and report results).
@@ -67,10 +67,10 @@ pub struct WorkArgs {
     #[command(flatten)]
     pub remote: Remote,
     /// Engine threads (rayon pool size); default all cores.
-    #[arg(long, env = "GRIT_THREADS")]
+    #[arg(long, env = "GRIT_THREADS", value_parser = crate::cli::thread_count)]
     pub threads: Option<usize>,
     /// Upload a checkpoint every this many impacts.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = crate::cli::at_least_one)]
     pub checkpoint_every: u32,
     /// Name reported to the coordinator (default host:pid).
     #[arg(long)]
@@ -79,11 +79,11 @@ pub struct WorkArgs {
     #[arg(long)]
     pub exit_when_idle: bool,
     /// Seconds between claims while the queue is empty.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, value_parser = crate::cli::seconds)]
     pub poll_s: f64,
     /// Seconds a request to the coordinator may take before the worker gives up on it and
     /// retries (a stalled coordinator holds requests open); must cover a checkpoint upload.
-    #[arg(long, env = "GRIT_REQUEST_TIMEOUT_S", default_value_t = grit_farm::client::DEFAULT_REQUEST_TIMEOUT.as_secs_f64())]
+    #[arg(long, env = "GRIT_REQUEST_TIMEOUT_S", default_value_t = grit_farm::client::DEFAULT_REQUEST_TIMEOUT.as_secs_f64(), value_parser = crate::cli::seconds)]
     pub request_timeout_s: f64,
 }
 

@@ -7,7 +7,7 @@ use grit_erosion::studies::settle::{settle_study, SettleRow};
 use grit_sph::coupling::DEFAULT_SWITCH_POROSITY;
 use grit_sph::verification::jet_grain::{self, GrainRide, RcScene, BEFORE_CONTACT_D, GRAIN_D};
 
-use super::output::say;
+use super::output::{check_writable, say};
 use super::sample::SceneArgs;
 use super::{pool, progress};
 
@@ -63,7 +63,7 @@ enum Study {
         #[arg(long)]
         chart: Option<std::path::PathBuf>,
         /// Worker threads of the engine (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = crate::cli::thread_count)]
         threads: Option<usize>,
         /// Print {scene, rides: [{label, contact_speed_m_s (the mean over releases),
         /// contact_speeds_m_s, contact_speed_std_m_s, speed_before_contact (the first release):
@@ -80,7 +80,7 @@ enum Study {
         #[command(flatten)]
         scene: SceneArgs,
         /// Number of impacts.
-        #[arg(long, default_value_t = 20)]
+        #[arg(long, default_value_t = 20, value_parser = crate::cli::impact_count)]
         impacts: u32,
         /// Seed of the sample.
         #[arg(long, default_value_t = 1)]
@@ -89,7 +89,7 @@ enum Study {
         #[arg(long, default_value_t = 0.002)]
         strict_fraction: f64,
         /// Worker threads of the engine (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = crate::cli::thread_count)]
         threads: Option<usize>,
         /// Print the rows as JSON.
         #[arg(long)]
@@ -121,6 +121,9 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
                 ..RcScene::new(across, jet_speed_m_s, release_ratio)
             };
             check_rc_scene(&scene, &rc, releases)?;
+            if let Some(path) = &chart {
+                check_writable("--chart", path)?;
+            }
             let series = pool(threads)?.install(|| -> anyhow::Result<Vec<Vec<GrainRide>>> {
                 eprintln!(
                     "settling the jet and riding {} grain(s) ...",
@@ -219,6 +222,12 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             json,
         } => {
             let p = scene.params()?;
+            if !(strict_fraction > 0.0 && strict_fraction < p.settle_fraction) {
+                bail!(
+                    "--strict-fraction: must be > 0 and below the scene's settle_fraction {}, got {strict_fraction}",
+                    p.settle_fraction
+                );
+            }
             let bar = progress::bar(impacts as u64, "impacts", true);
             let rows = pool(threads)?
                 .install(|| settle_study(&p, seed, impacts, strict_fraction, |_| bar.inc(1)))?;
@@ -258,15 +267,20 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
 
 /// Refuses a coupling-radius scene the study cannot run, naming the flag and the rule.
 fn check_rc_scene(scene: &RcScene, rc: &[f64], releases: usize) -> anyhow::Result<()> {
-    if scene.across < 2 || !scene.across.is_multiple_of(2) {
+    // The finest row documented runs 64 across (34 minutes); 128 is hours per ride.
+    if scene.across < 2 || !scene.across.is_multiple_of(2) || scene.across > 128 {
         bail!(
-            "--across: must be an even number >= 2, got {}",
+            "--across: must be an even number from 2 to 128, got {}",
             scene.across
         );
     }
-    if !(scene.jet_speed_m_s.is_finite() && scene.jet_speed_m_s > 0.0) {
+    let fastest = grit_erosion::jet::MAX_JET_SPEED_M_S;
+    if !(scene.jet_speed_m_s.is_finite()
+        && scene.jet_speed_m_s > 0.0
+        && scene.jet_speed_m_s <= fastest)
+    {
         bail!(
-            "--jet-speed-m-s: must be a finite number > 0, got {}",
+            "--jet-speed-m-s: must be > 0 and at most {fastest} m/s, got {}",
             scene.jet_speed_m_s
         );
     }

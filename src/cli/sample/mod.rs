@@ -20,7 +20,7 @@ use serde::Serialize;
 pub use scene::SceneArgs;
 use snapshots::Snapshots;
 
-use super::output::{say, write_json};
+use super::output::{check_writable, say, write_json};
 use super::{pool, progress};
 
 /// Arguments of `grit sample`.
@@ -29,13 +29,13 @@ pub struct SampleArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Number of impacts on the fresh surface.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = crate::cli::impact_count)]
     impacts: u32,
-    /// Seed of the random aim points and orientations.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Worker threads of the engine (default: all cores).
+    /// Seed of the random aim points and orientations [default: 1].
     #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads of the engine (default: all cores).
+    #[arg(long, value_parser = crate::cli::thread_count)]
     threads: Option<usize>,
     /// Print the result as JSON on stdout.
     #[arg(long)]
@@ -85,16 +85,20 @@ struct SampleOutput<'a> {
 
 /// Runs one sample locally with a progress bar and prints its mass-loss series.
 pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
-    if a.impacts == 0 {
-        bail!("impacts: must be at least 1");
+    if let Some(path) = &a.out {
+        check_writable("--out", path)?;
     }
     let mut s = match &a.resume {
         Some(path) => {
+            let seed = a.seed.is_some().then_some("--seed");
+            if let Some(flag) = a.scene.first_given().or(seed) {
+                bail!("{flag}: --resume runs the scene and seed stored in the checkpoint; leave the scene flags out");
+            }
             let bytes =
                 std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
             Sample::from_checkpoint(&bytes).with_context(|| format!("resume {}", path.display()))?
         }
-        None => Sample::new(a.scene.params()?, a.seed)?,
+        None => Sample::new(a.scene.params()?, a.seed.unwrap_or(1))?,
     };
     let p = s.params().clone();
     let seed = s.seed();

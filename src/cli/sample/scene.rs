@@ -37,19 +37,52 @@ pub struct SceneArgs {
     /// Mie–Grüneisen EOS, docs/jet.md).
     #[arg(long)]
     material: Option<String>,
-    /// Full scene as JSON (an ImpactParams object); flags above override its fields.
+    /// File holding the full scene as a JSON object (ImpactParams fields); flags above
+    /// override its fields.
     #[arg(long)]
     scene: Option<PathBuf>,
 }
 
 impl SceneArgs {
+    /// The first scene flag given, by its name: a checkpoint carries its own scene.
+    pub fn first_given(&self) -> Option<&'static str> {
+        [
+            ("--angle", self.angle.is_some()),
+            ("--shape", self.shape.is_some()),
+            ("--spacing-m", self.spacing_m.is_some()),
+            ("--velocity-m-s", self.velocity_m_s.is_some()),
+            (
+                "--distribution-range-dg",
+                self.distribution_range_dg.is_some(),
+            ),
+            ("--surface-width-dg", self.surface_width_dg.is_some()),
+            ("--surface-depth-dg", self.surface_depth_dg.is_some()),
+            ("--settle-fraction", self.settle_fraction.is_some()),
+            ("--material", self.material.is_some()),
+            ("--scene", self.scene.is_some()),
+        ]
+        .into_iter()
+        .find_map(|(flag, given)| given.then_some(flag))
+    }
+
     /// The validated scene; errors name the field and the rule.
     pub fn params(&self) -> anyhow::Result<ImpactParams> {
         let mut p = match &self.scene {
             Some(path) => {
                 let text = std::fs::read_to_string(path)
                     .with_context(|| format!("reading {}", path.display()))?;
-                serde_json::from_str(&text).with_context(|| format!("scene {}", path.display()))?
+                let v: serde_json::Value = serde_json::from_str(&text)
+                    .with_context(|| format!("scene {}", path.display()))?;
+                if !v.is_object() {
+                    bail!(
+                        "scene {}: must be a JSON object of ImpactParams fields",
+                        path.display()
+                    );
+                }
+                let de = &mut serde_json::Deserializer::from_str(&text);
+                serde_path_to_error::deserialize(de).map_err(|e| {
+                    anyhow::anyhow!("scene {}: {}: {}", path.display(), e.path(), e.inner())
+                })?
             }
             None => ImpactParams::default(),
         };

@@ -21,6 +21,13 @@ pub struct ShapesArgs {
 
 /// Prints the built-in shapes with their angularity and aspect ratio (Mohseni-Mofidi et al. 2022, Table 2).
 pub fn shapes(a: ShapesArgs) -> anyhow::Result<ExitCode> {
+    // Grains from a micrometre to a metre: any more and the areas overflow.
+    if !(a.diameter_m.is_finite() && (1e-6..=1.0).contains(&a.diameter_m)) {
+        anyhow::bail!(
+            "--diameter-m: must lie in [1e-6, 1] m, got {}",
+            grit_sph::InputError::shown(a.diameter_m)
+        );
+    }
     let infos = Shape::builtins()
         .iter()
         .map(|s| s.info(a.diameter_m))

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
+use anyhow::{bail, Context};
 use grit_sph::verification::{
     elastic_impact, hertz, hourglass, jet, jet_grain, sliding, slope, CaseReport, Row,
 };
@@ -71,6 +71,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Box::new(move || jet::run(jet_dt, jet_n, jet_settle, wall, rc)),
         ),
     ];
+    if let Some(o) = &a.only {
+        if !cases.iter().any(|(name, _)| want(name)) {
+            let names: Vec<&str> = cases.iter().map(|(name, _)| *name).collect();
+            bail!(
+                "--only: `{o}` is in no case group's name; the groups are {}",
+                names.join(", ")
+            );
+        }
+    }
+    // The folder is made before the cases run, so a bad path costs nothing.
+    if let Some(dir) = &a.charts {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
     for (name, f) in cases.iter() {
         if !want(name) {
             continue;
@@ -106,7 +119,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         }
     }
     if let Some(dir) = &a.charts {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for c in &rep.charts {
             let path = dir.join(format!("{}.svg", c.name));
             crate::cli::plot::line_chart(c, &path)?;
