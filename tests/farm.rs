@@ -89,6 +89,29 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     assert_eq!(farm["partial"], Value::Bool(false));
     let local = grit_run(dir.path(), &spec, "local", false);
     assert_eq!(farm, local, "farm results equal grit run results");
+    // The same spec again resumes (here: finds it done); another spec in the same folder is
+    // refused before it could overwrite the first one's results and charts.
+    assert_eq!(grit_run(dir.path(), &spec, "local", false), local);
+    let other = dir.path().join("other.json");
+    std::fs::write(&other, campaign(1, 2)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_grit"))
+        .args([
+            "run",
+            other.to_str().unwrap(),
+            "--workers",
+            "1",
+            "--quiet",
+            "--out",
+        ])
+        .arg(dir.path().join("local"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("holds the results of another campaign"),
+        "{stderr}"
+    );
     // The results say how they were made and whether they are steady-state rates: two
     // impacts per sample are far too few for the last-20 window.
     assert_eq!(farm["spec"]["samples"], 2, "{farm}");

@@ -73,6 +73,14 @@ pub enum EmbeddedError {
         /// What failed.
         source: crate::Error,
     },
+    /// The output folder holds another spec's campaign.
+    #[error("--out {out} holds the results of another campaign ({id}); give a fresh --out for this spec, or run that campaign's own spec there to resume it")]
+    OtherCampaign {
+        /// The folder.
+        out: PathBuf,
+        /// The campaign already in its database.
+        id: uuid::Uuid,
+    },
     /// A database operation failed.
     #[error(transparent)]
     Store(#[from] crate::Error),
@@ -128,6 +136,16 @@ pub async fn run(
     // Nothing else uses this file, so leases left by an interrupted run are dead.
     store.requeue_all_leases().await?;
     let key = any_campaign_key(spec)?;
+    // One campaign per folder: another spec's results.json and charts would overwrite this
+    // one's, and its charts would mix with them.
+    if !store.has_key(&key).await? {
+        if let Some(other) = store.list_campaigns().await?.first() {
+            return Err(EmbeddedError::OtherCampaign {
+                out: opts.out.clone(),
+                id: other.id,
+            });
+        }
+    }
     let created = store.create_any(spec, Some(&key)).await?;
     if !created.created {
         // Running again continues the campaign. Jobs that failed here mostly lost their lease

@@ -135,6 +135,15 @@ impl Store {
         })
     }
 
+    /// Whether a campaign was submitted under `key` (`Idempotency-Key`).
+    pub async fn has_key(&self, key: &str) -> Result<bool> {
+        let row = sqlx::query("SELECT 1 FROM campaigns WHERE idempotency_key = ?")
+            .bind(key)
+            .fetch_optional(&self.read)
+            .await?;
+        Ok(row.is_some())
+    }
+
     /// Every campaign, newest first, with state and progress.
     pub async fn list_campaigns(&self) -> Result<Vec<CampaignSummary>> {
         let rows = sqlx::query(
