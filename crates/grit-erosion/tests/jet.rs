@@ -63,6 +63,23 @@ fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
     // Another seed places other grains.
     let other = JetRun::resume(&tiny(), 6, &whole.checkpoint());
     assert!(other.is_err(), "a checkpoint resumed under another seed");
+    // Slices that are not the world's own: dropped, renumbered or one too few.
+    let edited = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_slice(&whole.checkpoint()).unwrap();
+        edit(&mut v);
+        JetRun::from_checkpoint(&serde_json::to_vec(&v).unwrap())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let e = edited(&|v| v["slices"] = serde_json::json!([]));
+    assert!(e.contains("holds 0 slices but its world is at"), "{e}");
+    let e = edited(&|v| v["slices"][1]["slice"] = 7.into());
+    assert!(e.contains("slices[1] is numbered 7, not 2"), "{e}");
+    let e = edited(&|v| {
+        v["slices"].as_array_mut().unwrap().pop();
+    });
+    assert!(e.contains("holds 3 slices"), "{e}");
 }
 
 #[test]

@@ -618,6 +618,29 @@ impl JetRun {
             )));
         }
         c.params.validate()?;
+        // The slices must be the world's own: numbered 1, 2, … and as many as the world's
+        // clock has passed the ends of (a slice ends on the first step past its end).
+        if let Some(i) = (0..c.slices.len()).find(|&i| c.slices[i].slice as usize != i + 1) {
+            return Err(JetError::Checkpoint(format!(
+                "slices[{i}] is numbered {}, not {}",
+                c.slices[i].slice,
+                i + 1
+            )));
+        }
+        let n = c.slices.len() as u32;
+        let t = c.world.time();
+        let from = if n == 0 {
+            0.0
+        } else {
+            c.params.slice_end_s(n - 1)
+        };
+        let to = (n < c.params.slices()).then(|| c.params.slice_end_s(n));
+        if t < from || to.is_some_and(|to| t >= to) {
+            return Err(JetError::Checkpoint(format!(
+                "holds {n} slices but its world is at t = {t:e} s, outside the span from the end of slice {n} ({from:e} s) to the end of the next{}",
+                to.map_or(String::new(), |to| format!(" ({to:e} s)"))
+            )));
+        }
         let layout = Layout::of(&c.params);
         Ok(JetRun {
             params: c.params,
