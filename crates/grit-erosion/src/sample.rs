@@ -5,6 +5,7 @@ use grit_sph::{Particles, Timers};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 use crate::aggregate::Impact;
 use crate::impact::{
@@ -13,7 +14,11 @@ use crate::impact::{
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
-pub const CHECKPOINT_VERSION: u32 = 5;
+pub const CHECKPOINT_VERSION: u32 = 6;
+/// The version before checkpoints carried their checksum; still read.
+const UNCHECKED_VERSION: u32 = 5;
+/// Bytes of the SHA-256 checksum after a checkpoint's body.
+const SHA256_LEN: usize = 32;
 
 /// One impact of a sample as reported to the farm and printed by `grit sample`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -191,7 +196,9 @@ impl Sample {
         Ok(self.records.last().expect("just pushed"))
     }
 
-    /// The state after the last finished impact, as bytes (postcard; floats kept bit for bit).
+    /// The state after the last finished impact, as bytes (postcard; floats kept bit for bit),
+    /// followed by the SHA-256 of those bytes, so a file damaged at rest is refused instead of
+    /// resumed into different numbers.
     pub fn checkpoint(&self) -> Vec<u8> {
         let c = Checkpoint {
             version: CHECKPOINT_VERSION,
@@ -200,7 +207,10 @@ impl Sample {
             surface: self.surface.clone(),
             records: self.records.clone(),
         };
-        postcard::to_stdvec(&c).expect("a checkpoint always serialises")
+        let mut bytes = postcard::to_stdvec(&c).expect("a checkpoint always serialises");
+        let digest = Sha256::digest(&bytes);
+        bytes.extend_from_slice(&digest);
+        bytes
     }
 
     /// Goes on from `checkpoint()` bytes. The parameters and seed must be the job's own:
@@ -218,7 +228,7 @@ impl Sample {
     /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them (for
     /// replaying a job's checkpoint by hand; the farm uses `resume`).
     pub fn from_checkpoint(bytes: &[u8]) -> Result<Sample, SampleError> {
-        let c: Checkpoint = postcard::from_bytes(bytes).map_err(|e| {
+        let (c, rest): (Checkpoint, &[u8]) = postcard::take_from_bytes(bytes).map_err(|e| {
             SampleError::Checkpoint(match e {
                 postcard::Error::DeserializeUnexpectedEnd => {
                     "truncated: the bytes end before the checkpoint does, so it cannot decode"
@@ -227,11 +237,28 @@ impl Sample {
                 e => format!("cannot decode: {e}"),
             })
         })?;
-        if c.version != CHECKPOINT_VERSION {
-            return Err(SampleError::Checkpoint(format!(
-                "version {} but this build reads {CHECKPOINT_VERSION}",
-                c.version
-            )));
+        match c.version {
+            CHECKPOINT_VERSION => {
+                let body = &bytes[..bytes.len() - rest.len()];
+                if rest.len() != SHA256_LEN {
+                    return Err(SampleError::Checkpoint(format!(
+                        "truncated: {} of the {SHA256_LEN} bytes of its checksum are there",
+                        rest.len().min(SHA256_LEN)
+                    )));
+                }
+                if Sha256::digest(body).as_slice() != rest {
+                    return Err(SampleError::Checkpoint(
+                        "damaged: its bytes do not match their SHA-256 checksum".into(),
+                    ));
+                }
+            }
+            // Written before checkpoints carried a checksum: read as they are.
+            UNCHECKED_VERSION if rest.is_empty() => {}
+            v => {
+                return Err(SampleError::Checkpoint(format!(
+                    "version {v} but this build reads {UNCHECKED_VERSION} and {CHECKPOINT_VERSION}"
+                )))
+            }
         }
         let saved: ImpactParams = serde_json::from_str(&c.params_json)
             .map_err(|e| SampleError::Checkpoint(format!("cannot decode parameters: {e}")))?;

@@ -82,6 +82,28 @@ fn checkpoint_of_another_job_or_garbage_is_refused() {
     assert!(matches!(other_angle, SampleError::Checkpoint(_)));
     let garbage = Sample::resume(&params, 5, &[1, 2, 3]).unwrap_err();
     assert!(matches!(garbage, SampleError::Checkpoint(ref m) if m.contains("decode")));
+    // One bit flipped in a particle's state, or the checksum cut off: refused, not resumed
+    // into other numbers.
+    let refusal = |b: &[u8]| match Sample::from_checkpoint(b) {
+        Err(SampleError::Checkpoint(m)) => m,
+        other => panic!("expected a refusal, got {:?}", other.map(|_| ())),
+    };
+    let mut flipped = bytes.clone();
+    let at = bytes.len() - 40;
+    flipped[at] ^= 0x10;
+    assert!(
+        refusal(&flipped).starts_with("damaged"),
+        "{}",
+        refusal(&flipped)
+    );
+    assert!(refusal(&bytes[..bytes.len() - 5]).starts_with("truncated"));
+    // A checkpoint written before the checksum (version 5, the same layout without it) reads.
+    let body = &bytes[..bytes.len() - 32];
+    let mut old = body.to_vec();
+    assert_eq!(old[0], grit_erosion::sample::CHECKPOINT_VERSION as u8);
+    old[0] = 5;
+    let back = Sample::from_checkpoint(&old).unwrap();
+    assert_eq!(back.seed(), 5);
 }
 
 #[test]

@@ -131,6 +131,26 @@ impl JetParams {
         ] {
             InputError::require_positive(name, v)?;
         }
+        let densest = crate::impact::MAX_DENSITY_KG_M3;
+        if self.grain_density_kg_m3 > densest {
+            return Err(InputError::new(
+                "grain_density_kg_m3",
+                format!(
+                    "must be at most {densest} kg/m³ (denser than any solid), got {}",
+                    InputError::shown(self.grain_density_kg_m3)
+                ),
+            ));
+        }
+        // The paper studies 1.0 to 3.0 d; the pair search grows as R_c².
+        if !(0.5..=10.0).contains(&self.coupling_radius_d) {
+            return Err(InputError::new(
+                "coupling_radius_d",
+                format!(
+                    "must lie in [0.5, 10] grain diameters (the paper's study spans 1 to 3), got {}",
+                    InputError::shown(self.coupling_radius_d)
+                ),
+            ));
+        }
         if !(self.grain_speed_ratio > 0.0 && self.grain_speed_ratio <= 1.0) {
             return Err(InputError::new(
                 "grain_speed_ratio",
