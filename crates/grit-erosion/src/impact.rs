@@ -231,6 +231,17 @@ pub const MAX_DENSITY_KG_M3: f64 = 25_000.0;
 /// size that would exhaust a worker's memory (the seed's scene has about 6 000).
 pub const MAX_SURFACE_PARTICLES: f64 = 5e5;
 
+/// The bound every scene keeps on its grains' density ([`MAX_DENSITY_KG_M3`]).
+pub(crate) fn check_grain_density(rho: f64) -> Result<(), InputError> {
+    InputError::require_at_most(
+        "grain_density_kg_m3",
+        rho,
+        MAX_DENSITY_KG_M3,
+        "kg/m³",
+        "denser than any solid",
+    )
+}
+
 /// Fewest particle layers a surface may have: fixed layers below, free layers between, and as
 /// many again for the impact to work in.
 pub const MIN_SURFACE_LAYERS: f64 = 3.0 * FIXED_LAYERS;
@@ -283,24 +294,14 @@ impl ImpactParams {
                 ),
             ));
         }
-        if self.velocity_m_s > MAX_VELOCITY_M_S {
-            return Err(InputError::new(
-                "velocity_m_s",
-                format!(
-                    "must be at most {MAX_VELOCITY_M_S} m/s (solid particle erosion; the seed's grains fly at 100 m/s), got {}",
-                    InputError::shown(self.velocity_m_s)
-                ),
-            ));
-        }
-        if self.grain_density_kg_m3 > MAX_DENSITY_KG_M3 {
-            return Err(InputError::new(
-                "grain_density_kg_m3",
-                format!(
-                    "must be at most {MAX_DENSITY_KG_M3} kg/m³ (denser than any solid), got {}",
-                    InputError::shown(self.grain_density_kg_m3)
-                ),
-            ));
-        }
+        InputError::require_at_most(
+            "velocity_m_s",
+            self.velocity_m_s,
+            MAX_VELOCITY_M_S,
+            "m/s",
+            "solid particle erosion; the seed's grains fly at 100 m/s",
+        )?;
+        check_grain_density(self.grain_density_kg_m3)?;
         if self.grain_diameter_m / self.spacing_m < 6.0 {
             return Err(InputError::new(
                 "spacing_m",

@@ -31,6 +31,26 @@ impl InputError {
         }
     }
 
+    /// Checks an upper bound: `v` at most `max` `unit`, `why` saying where the bound comes from.
+    pub fn require_at_most(
+        field: impl Into<String>,
+        v: f64,
+        max: f64,
+        unit: &str,
+        why: &str,
+    ) -> Result<(), InputError> {
+        if v <= max {
+            return Ok(());
+        }
+        Err(InputError::new(
+            field,
+            format!(
+                "must be at most {max} {unit} ({why}), got {}",
+                InputError::shown(v)
+            ),
+        ))
+    }
+
     /// Checks the rule most physical inputs share: a finite number > 0 (errors name the field and
     /// the rule: docs/design.md#rules-the-engine-keeps).
     pub fn require_positive(field: impl Into<String>, v: f64) -> Result<(), InputError> {

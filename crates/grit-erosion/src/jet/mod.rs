@@ -131,16 +131,7 @@ impl JetParams {
         ] {
             InputError::require_positive(name, v)?;
         }
-        let densest = crate::impact::MAX_DENSITY_KG_M3;
-        if self.grain_density_kg_m3 > densest {
-            return Err(InputError::new(
-                "grain_density_kg_m3",
-                format!(
-                    "must be at most {densest} kg/m³ (denser than any solid), got {}",
-                    InputError::shown(self.grain_density_kg_m3)
-                ),
-            ));
-        }
+        crate::impact::check_grain_density(self.grain_density_kg_m3)?;
         // The paper studies 1.0 to 3.0 d; the pair search grows as R_c².
         if !(0.5..=10.0).contains(&self.coupling_radius_d) {
             return Err(InputError::new(
@@ -240,24 +231,20 @@ impl JetParams {
                 ),
             ));
         }
-        if self.time_ms > MAX_TIME_MS {
-            return Err(InputError::new(
-                "time_ms",
-                format!(
-                    "must be at most {MAX_TIME_MS} ms (the seed's longest run is 60 ms), got {}",
-                    InputError::shown(self.time_ms)
-                ),
-            ));
-        }
-        if self.velocity_m_s > MAX_JET_SPEED_M_S {
-            return Err(InputError::new(
-                "velocity_m_s",
-                format!(
-                    "must be at most {MAX_JET_SPEED_M_S} m/s (abrasive water jets run at 300-900 m/s), got {}",
-                    InputError::shown(self.velocity_m_s)
-                ),
-            ));
-        }
+        InputError::require_at_most(
+            "time_ms",
+            self.time_ms,
+            MAX_TIME_MS,
+            "ms",
+            "the seed's longest run is 60 ms",
+        )?;
+        InputError::require_at_most(
+            "velocity_m_s",
+            self.velocity_m_s,
+            MAX_JET_SPEED_M_S,
+            "m/s",
+            "abrasive water jets run at 300-900 m/s",
+        )?;
         let area = self.target_width_m * self.target_depth_m + self.jet_width_m * self.standoff_m;
         let particles = area / (self.spacing_m * self.spacing_m);
         if particles > MAX_SCENE_PARTICLES {
