@@ -578,6 +578,13 @@ mod tests {
         assert!(e.rule.contains("at least 1"), "{e}");
         // Sizes that would hold a worker for years or exhaust its memory.
         assert_eq!(field_of(r#""velocity_m_s": 1e300"#), "velocity_m_s");
+        // A jet whose head would not reach the target within the run.
+        let e = parse(r#""velocity_m_s": 1e-6"#)
+            .unwrap()
+            .validate()
+            .unwrap_err();
+        assert_eq!(e.field, "velocity_m_s");
+        assert!(e.rule.contains("too slow for the run"), "{e}");
         assert_eq!(field_of(r#""time_ms": 2000, "slice_ms": 1"#), "time_ms");
         assert_eq!(
             field_of(r#""spacing_m": 1e-7, "jet_width_m": 6e-4"#),

@@ -245,6 +245,17 @@ impl JetParams {
             "m/s",
             "abrasive water jets run at 300-900 m/s",
         )?;
+        let arrival_ms = self.standoff_m / self.velocity_m_s * 1e3;
+        if arrival_ms >= self.time_ms {
+            return Err(InputError::new(
+                "velocity_m_s",
+                format!(
+                    "is too slow for the run: the jet's head needs standoff_m / velocity_m_s = {} ms to reach the target, and the run lasts time_ms = {} ms",
+                    InputError::shown(arrival_ms),
+                    InputError::shown(self.time_ms)
+                ),
+            ));
+        }
         let area = self.target_width_m * self.target_depth_m + self.jet_width_m * self.standoff_m;
         let particles = area / (self.spacing_m * self.spacing_m);
         if particles > MAX_SCENE_PARTICLES {
