@@ -154,7 +154,7 @@ fn sweep_runs_two_variants_resumes_and_charts() {
 fn studies_refuse_bad_input_naming_the_option() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let cases: [(&[&str], &str); 23] = [
+    let cases: [(&[&str], &str); 24] = [
         (
             &["bench", "impact", "--repeat", "0"],
             "--repeat: must be at least 1",
@@ -215,6 +215,10 @@ fn studies_refuse_bad_input_naming_the_option() {
         (
             &["run", "examples/quick.json", "--workers", "100000"],
             "'--workers <WORKERS>': must be a whole number from 1 to 1024",
+        ),
+        (
+            &["sample", "--angle", "-5"],
+            "angle_deg: must be in (0, 90], got -5",
         ),
         (&["shapes", "--diameter-m", "1e300"], "--diameter-m: must lie in [1e-6, 1] m, got 1e300"),
         (

@@ -77,10 +77,10 @@ enum BenchWhat {
     #[command(after_help = "Example: grit bench stability --cfl 0.3,1.0,2.0 --out out/stability")]
     Stability {
         /// Impact angle (degrees).
-        #[arg(long, default_value_t = 45.0)]
+        #[arg(long, default_value_t = 45.0, allow_negative_numbers = true)]
         angle: f64,
         /// Particle spacing Δx (m): 1.5625e-5 is 16 particles per Dg.
-        #[arg(long, default_value_t = 1.5625e-5)]
+        #[arg(long, default_value_t = 1.5625e-5, allow_negative_numbers = true)]
         spacing_m: f64,
         /// Impacts the surface takes (with the default numerics) before the mapped one.
         #[arg(long, default_value_t = 0)]
@@ -89,17 +89,17 @@ enum BenchWhat {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Courant numbers, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().cfl)]
+        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().cfl, allow_negative_numbers = true)]
         cfl: Vec<f64>,
         /// Hourglass coefficients α, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().hourglass)]
+        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().hourglass, allow_negative_numbers = true)]
         hourglass: Vec<f64>,
         /// Contact stiffness over the default k, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().stiffness_scale)]
+        #[arg(long, value_delimiter = ',', default_values_t = StabilityGrid::default().stiffness_scale, allow_negative_numbers = true)]
         stiffness: Vec<f64>,
         /// A point is stopped as collapsed after this many times the steps the longest impact
         /// takes at its first step's dt.
-        #[arg(long, default_value_t = 3.0)]
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
         budget: f64,
         /// Output folder.
         #[arg(long, default_value = "out/stability")]
@@ -114,7 +114,7 @@ enum BenchWhat {
 #[derive(Debug, clap::Args)]
 pub struct SweepArgs {
     /// Impact angle (degrees).
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(long, default_value_t = 45.0, allow_negative_numbers = true)]
     angle: f64,
     /// Resolutions, particles per grain diameter, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = vec![8.0, 12.0, 16.0, 24.0, 32.0])]
@@ -128,7 +128,7 @@ pub struct SweepArgs {
     #[arg(long, value_delimiter = ',', default_values_t = vec!["seed".to_string(), "wendland_c2".to_string()])]
     variants: Vec<String>,
     /// Resolutions of the variants after the first (default: all of --ppd).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     variant_ppd: Vec<f64>,
     /// Samples per point.
     #[arg(long, default_value_t = 5)]
@@ -140,13 +140,13 @@ pub struct SweepArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Width of the band of aim points (Dg); the reduced campaign's 0.5 by default.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     range_dg: f64,
     /// Surface width (Dg); the reduced campaign's 2.5 (checked by its domain study).
-    #[arg(long, default_value_t = 2.5)]
+    #[arg(long, default_value_t = 2.5, allow_negative_numbers = true)]
     width_dg: f64,
     /// Surface depth (Dg); the reduced campaign's 1.25.
-    #[arg(long, default_value_t = 1.25)]
+    #[arg(long, default_value_t = 1.25, allow_negative_numbers = true)]
     depth_dg: f64,
     /// Output folder.
     #[arg(long, default_value = "out/sweep")]
@@ -188,10 +188,10 @@ impl SweepArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct ImpactScene {
     /// Impact angle (degrees).
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(long, default_value_t = 45.0, allow_negative_numbers = true)]
     angle: f64,
     /// Particle spacing Δx (m); 8e-6 is the reference, coarser ones are quicker.
-    #[arg(long, default_value_t = 8e-6)]
+    #[arg(long, default_value_t = 8e-6, allow_negative_numbers = true)]
     spacing_m: f64,
     /// Impacts the surface takes before the timed one (the second reference scene: 30).
     #[arg(long, default_value_t = 0)]

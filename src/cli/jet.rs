@@ -27,22 +27,22 @@ pub struct JetArgs {
     #[arg(long)]
     material: Option<String>,
     /// Jet speed at the nozzle (m/s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     velocity_m_s: Option<f64>,
     /// Abrasive mass flow (kg/s); 0 for a pure water jet.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     mass_flow_kg_s: Option<f64>,
     /// Simulated time (ms).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     time_ms: Option<f64>,
     /// Time between crater samples (ms).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     slice_ms: Option<f64>,
     /// Particle spacing of water and target (m).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     spacing_m: Option<f64>,
     /// Coupling radius over grain diameter.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     coupling_radius_d: Option<f64>,
     /// Seed of the abrasive placement.
     #[arg(long, default_value_t = 1)]

@@ -32,29 +32,34 @@ enum Study {
         #[arg(long, default_value_t = 16)]
         across: usize,
         /// The jet's speed (m/s).
-        #[arg(long, default_value_t = 500.0)]
+        #[arg(long, default_value_t = 500.0, allow_negative_numbers = true)]
         jet_speed_m_s: f64,
         /// The grain's speed at release over the jet's (0: at rest).
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         release_ratio: f64,
         /// The porosity at and below which the unresolved drag is Ergun's, above it Wen–Yu's
         /// (the paper's 0.8; eq. 44).
-        #[arg(long, default_value_t = DEFAULT_SWITCH_POROSITY)]
+        #[arg(long, default_value_t = DEFAULT_SWITCH_POROSITY, allow_negative_numbers = true)]
         switch_porosity: f64,
         /// Courant number of the steps (the paper's 0.2; a 500 m/s jet 48 or more across fails
         /// at it while settling and runs at 0.1).
-        #[arg(long, default_value_t = RcScene::DEFAULT_CFL)]
+        #[arg(long, default_value_t = RcScene::DEFAULT_CFL, allow_negative_numbers = true)]
         cfl: f64,
         /// When the first grain leaves the nozzle, in transit times b/v from the jet's start (its
         /// head reaches the wall at 2; the default is once the jet has settled).
-        #[arg(long, default_value_t = RcScene::DEFAULT_RELEASE_AT)]
+        #[arg(long, default_value_t = RcScene::DEFAULT_RELEASE_AT, allow_negative_numbers = true)]
         release_at_b_over_v: f64,
         /// Grains released per ride, one transit time b/v apart into the same settled jet; a
         /// ride's contact speed is then their mean (one landing scatters by 3–5 %).
         #[arg(long, default_value_t = 1)]
         releases: usize,
         /// Coupling radii R_c/d of the unresolved grains, comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "1,1.5,2,2.5,3")]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "1,1.5,2,2.5,3",
+            allow_negative_numbers = true
+        )]
         rc: Vec<f64>,
         /// Also ride a fully resolved grain (an elastic garnet disc of the water's spacing).
         #[arg(long)]
@@ -86,7 +91,7 @@ enum Study {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// The stricter settle fraction.
-        #[arg(long, default_value_t = 0.002)]
+        #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
         strict_fraction: f64,
         /// Worker threads of the engine (default: all cores).
         #[arg(long, value_parser = crate::cli::thread_count)]

@@ -10,28 +10,28 @@ use grit_erosion::{ImpactParams, Shape};
 pub struct SceneArgs {
     /// Impact angle, degrees from the surface, in (0, 90] (required unless a scene file or
     /// checkpoint gives it).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     angle: Option<f64>,
     /// Grain shape: octagon, hexagon, square, rectangle or circle [default: hexagon].
     #[arg(long)]
     shape: Option<String>,
     /// Particle spacing Δx (m); Mohseni-Mofidi et al. 2022 use 8e-6.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     spacing_m: Option<f64>,
     /// Impact speed (m/s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     velocity_m_s: Option<f64>,
     /// Aim-point range in grain diameters.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     distribution_range_dg: Option<f64>,
     /// Surface width in grain diameters.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     surface_width_dg: Option<f64>,
     /// Surface depth in grain diameters.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     surface_depth_dg: Option<f64>,
     /// End an impact once the surface kinetic energy is below this fraction of the grain's.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     settle_fraction: Option<f64>,
     /// Surface material by name: aisi304 (the seed's), copper or al6061 (Johnson–Cook with the
     /// Mie–Grüneisen EOS, docs/jet.md).

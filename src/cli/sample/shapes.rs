@@ -15,7 +15,7 @@ pub struct ShapesArgs {
     #[arg(long)]
     json: bool,
     /// Grain diameter Dg the areas refer to (m).
-    #[arg(long, default_value_t = 250e-6)]
+    #[arg(long, default_value_t = 250e-6, allow_negative_numbers = true)]
     diameter_m: f64,
 }
 
