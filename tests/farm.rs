@@ -408,6 +408,15 @@ async fn auth_validation_size_and_unknown_ids() {
     assert_eq!(status_of(&r), 415);
     assert!(r.json::<Value>().await.unwrap()["error"].is_string());
     let r = http
+        .post(format!("{api}/worker/claim"))
+        .bearer_auth(WORKER)
+        .header("content-type", "application/json; charset=utf-8")
+        .body(r#"{"worker": "w"} trailing"#)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(status_of(&r), 400, "trailing characters after the JSON");
+    let r = http
         .post(format!("{api}/worker/jobs/abc/heartbeat"))
         .bearer_auth(WORKER)
         .json(&serde_json::json!({"lease_id": Uuid::new_v4()}))

@@ -88,9 +88,13 @@ pub struct ApiJson<T>(pub T);
 
 /// Whether a `Content-Type` names JSON: `application/json` or a `+json` type, any parameters.
 fn is_json(content_type: &str) -> bool {
-    let mime = content_type.split(';').next().unwrap_or("").trim();
-    mime.eq_ignore_ascii_case("application/json")
-        || (mime.len() > 5 && mime[mime.len() - 5..].eq_ignore_ascii_case("+json"))
+    let mime = content_type
+        .split(';')
+        .next()
+        .unwrap_or("")
+        .trim()
+        .to_ascii_lowercase();
+    mime == "application/json" || (mime.ends_with("+json") && mime.len() > 5)
 }
 
 impl<S, T> FromRequest<S> for ApiJson<T>
@@ -118,8 +122,12 @@ where
                 status: r.status(),
                 message: r.body_text(),
             })?;
+        let malformed = |e: serde_json::Error| Error::BadRequest {
+            status: StatusCode::BAD_REQUEST,
+            message: format!("malformed JSON: {e}"),
+        };
         let de = &mut serde_json::Deserializer::from_slice(&body);
-        let value = serde_path_to_error::deserialize(de).map_err(|e| {
+        let value = serde_path_to_error::deserialize(&mut *de).map_err(|e| {
             let path = e.path().to_string();
             let inner = e.into_inner();
             if inner.is_data() && path != "." {
@@ -127,12 +135,10 @@ where
             } else if inner.is_data() {
                 Error::invalid("(body)", inner.to_string())
             } else {
-                Error::BadRequest {
-                    status: StatusCode::BAD_REQUEST,
-                    message: format!("malformed JSON: {inner}"),
-                }
+                malformed(inner)
             }
         })?;
+        de.end().map_err(malformed)?;
         Ok(ApiJson(value))
     }
 }
