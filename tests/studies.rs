@@ -157,7 +157,7 @@ fn studies_refuse_bad_input_naming_the_option() {
     let cases: [(&[&str], &str); 24] = [
         (
             &["bench", "impact", "--repeat", "0"],
-            "--repeat: must be at least 1",
+            "'--repeat <REPEAT>': must be a whole number from 1 to 1000",
         ),
         (
             &["bench", "impact", "--threads", "0"],
@@ -177,7 +177,7 @@ fn studies_refuse_bad_input_naming_the_option() {
         ),
         (
             &["verify", "--only", "nosuchcase"],
-            "--only: `nosuchcase` is in no case group's name",
+            "--only: `nosuchcase` is in no case's name",
         ),
         (
             &["sample", "--angle", "45", "--impacts", "1000000000"],
@@ -185,7 +185,7 @@ fn studies_refuse_bad_input_naming_the_option() {
         ),
         (
             &["sample", "--angle", "45", "--spacing-m", "1e-9"],
-            "spacing_m: gives a surface of 3.750e11 particles",
+            "spacing_m: must be at most 512 particles per grain diameter",
         ),
         (
             &["sample", "--angle", "45", "--velocity-m-s", "1e6"],

@@ -57,7 +57,7 @@ enum BenchWhat {
         #[arg(long, default_value_t = 2, value_parser = crate::cli::thread_count)]
         threads: usize,
         /// Alternate the 1-thread and the N-thread run this many times and report medians.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = crate::cli::repeat_count)]
         repeat: usize,
         /// Print the figures as JSON.
         #[arg(long)]
@@ -83,7 +83,7 @@ enum BenchWhat {
         #[arg(long, default_value_t = 1.5625e-5, allow_negative_numbers = true)]
         spacing_m: f64,
         /// Impacts the surface takes (with the default numerics) before the mapped one.
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, default_value_t = 0, value_parser = crate::cli::impacts_before)]
         after: u32,
         /// Seed of the sample the grain comes from.
         #[arg(long, default_value_t = 1)]
@@ -194,7 +194,7 @@ pub struct ImpactScene {
     #[arg(long, default_value_t = 8e-6, allow_negative_numbers = true)]
     spacing_m: f64,
     /// Impacts the surface takes before the timed one (the second reference scene: 30).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = crate::cli::impacts_before)]
     after: u32,
     /// Seed of the sample.
     #[arg(long, default_value_t = 1)]

@@ -65,7 +65,7 @@ pub struct Remote {
 
 /// How long a client command waits for the coordinator's answer: a coordinator that accepts
 /// the connection and never answers fails the command instead of holding it.
-const COMMAND_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(60);
+const COMMAND_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(30);
 
 impl Remote {
     fn client(self) -> anyhow::Result<Client> {

@@ -113,6 +113,10 @@ impl JetArgs {
         set(&mut p.mass_flow_kg_s, self.mass_flow_kg_s);
         set(&mut p.time_ms, self.time_ms);
         set(&mut p.slice_ms, self.slice_ms);
+        // A run shorter than the default slice is one slice, unless a slice was asked for.
+        if self.slice_ms.is_none() && self.scene.is_none() && p.time_ms < p.slice_ms {
+            p.slice_ms = p.time_ms;
+        }
         set(&mut p.spacing_m, self.spacing_m);
         set(&mut p.coupling_radius_d, self.coupling_radius_d);
         p.validate()?;

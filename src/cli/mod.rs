@@ -59,6 +59,23 @@ pub fn impact_count(s: &str) -> Result<u32, String> {
     }
 }
 
+/// Parser of impacts taken before a measured one: 0 to the most a sample may be planned with.
+pub fn impacts_before(s: &str) -> Result<u32, String> {
+    use grit_erosion::campaign::MAX_IMPACTS;
+    match s.parse::<u32>() {
+        Ok(n) if n <= MAX_IMPACTS => Ok(n),
+        _ => Err(format!("must be a whole number from 0 to {MAX_IMPACTS}")),
+    }
+}
+
+/// Parser of a benchmark's repeats: 1 to 1000.
+pub fn repeat_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=1000).contains(&n) => Ok(n),
+        _ => Err("must be a whole number from 1 to 1000".into()),
+    }
+}
+
 /// Parser of a request-size limit: 1 KiB (the smallest request) to 4 GiB.
 pub fn body_bytes(s: &str) -> Result<usize, String> {
     const MAX: usize = 4 << 30;

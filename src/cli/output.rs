@@ -46,6 +46,9 @@ fn write_atomic(
 /// Fails now, naming `flag`, if `path` could not be written later: its folder must take the
 /// temporary file `write_atomic` writes there, so a long run does not end in a write error.
 pub fn check_writable(flag: &str, path: &Path) -> anyhow::Result<()> {
+    if path.is_dir() {
+        anyhow::bail!("{flag} {}: is a folder; give a file name", path.display());
+    }
     write_atomic(&probe_path(path)?, |_| Ok(()))
         .and_then(|()| Ok(std::fs::remove_file(probe_path(path)?)?))
         .with_context(|| format!("{flag} {}: cannot write there", path.display()))

@@ -99,6 +99,9 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
         .parse::<SocketAddr>()
         .is_ok_and(|s| s.ip().is_loopback())
         || a.listen.starts_with("localhost:");
+    if submit_token.expose().is_some() && submit_token.expose() == worker_token.expose() {
+        bail!("the submit and worker tokens are the same: a worker could then submit and cancel campaigns; give each role its own");
+    }
     let missing = submit_token.expose().is_none() || worker_token.expose().is_none();
     if missing && !loopback && !a.insecure_no_auth {
         bail!("set GRIT_SUBMIT_TOKEN and GRIT_WORKER_TOKEN (or --*-token-file) before listening on a non-loopback address, or pass --insecure-no-auth");

@@ -286,7 +286,7 @@ fn check_rc_scene(scene: &RcScene, rc: &[f64], releases: usize) -> anyhow::Resul
     {
         bail!(
             "--jet-speed-m-s: must be > 0 and at most {fastest} m/s, got {}",
-            scene.jet_speed_m_s
+            grit_sph::InputError::shown(scene.jet_speed_m_s)
         );
     }
     if !(scene.release_ratio.is_finite() && (0.0..=2.0).contains(&scene.release_ratio)) {
@@ -315,8 +315,12 @@ fn check_rc_scene(scene: &RcScene, rc: &[f64], releases: usize) -> anyhow::Resul
     if !(1..=20).contains(&releases) {
         bail!("--releases: must lie in 1..=20, got {releases}");
     }
-    if let Some(f) = rc.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        bail!("--rc: every coupling radius must be a finite number > 0, got {f}");
+    // The bounds of a jet scene's coupling_radius_d; the paper's study spans 1 to 3 d.
+    if let Some(f) = rc.iter().find(|f| !(0.5..=10.0).contains(*f)) {
+        bail!(
+            "--rc: every coupling radius must lie in [0.5, 10] grain diameters, got {}",
+            grit_sph::InputError::shown(*f)
+        );
     }
     Ok(())
 }

@@ -54,6 +54,28 @@ pub const MAX_JOBS: usize = 1_000_000;
 /// Most impacts one sample may be planned with (fixed, or `until_steady.max`): about a week of
 /// one core at the seed's resolution, a guard against a typo that would hold a worker for years.
 pub const MAX_IMPACTS: u32 = 100_000;
+/// Most cells one campaign may have: each is a row with its scene in the database, checked at
+/// submission (the paper's campaign has 24).
+pub const MAX_CELLS: usize = 10_000;
+/// Most impacts one campaign may plan at its largest (every sample at its `max`): about six
+/// CPU-years at the seed's resolution, a guard against a typo that would fill the database.
+pub const MAX_IMPACTS_TOTAL: u128 = 100_000_000;
+
+/// The rule on the cell count: at most [`MAX_CELLS`], named on the longest list of `dims`.
+fn check_cells(dims: &[(&'static str, usize)]) -> Result<(), SpecError> {
+    let cells = dims
+        .iter()
+        .fold(1u128, |n, (_, len)| n.saturating_mul(*len as u128));
+    if cells > MAX_CELLS as u128 {
+        let longest = dims.iter().max_by_key(|(_, len)| *len).map_or("", |d| d.0);
+        return Err(err(
+            longest,
+            format!("the lists multiply into {cells} cells, more than the limit of {MAX_CELLS}"),
+        ));
+    }
+    Ok(())
+}
+
 /// Most values one list of a spec may hold (angles, shapes, each swept field): the product of
 /// the lists is the cell count, which must stay countable and checkable at submission.
 pub const MAX_LIST: usize = 1_000;
@@ -526,6 +548,27 @@ impl CampaignSpec {
                 format!("the campaign expands into {jobs} jobs, more than the limit of {MAX_JOBS}"),
             ));
         }
+        check_cells(&self.dims())?;
+        let per_angle = (self.cell_count() / self.angles_deg.len()) as u128;
+        let most: u128 = self
+            .angles_deg
+            .iter()
+            .filter_map(|a| self.impacts.plan_at(*a))
+            .map(|plan| match plan {
+                ImpactPlan::Fixed(n) => n as u128,
+                ImpactPlan::UntilSteady(u) => u.max as u128,
+            })
+            .sum::<u128>()
+            * per_angle
+            * self.samples.max() as u128;
+        if most > MAX_IMPACTS_TOTAL {
+            return Err(err(
+                "impacts",
+                format!(
+                    "the campaign plans up to {most} impacts (cells × samples × impacts at their largest), more than the limit of {MAX_IMPACTS_TOTAL}"
+                ),
+            ));
+        }
         // Scene rules (resolution, surface size, material constants) live with the scene;
         // check each distinct combination once through it.
         for cell in self.cells_unchecked() {
@@ -884,14 +927,29 @@ mod tests {
             field_of(r#"{"grain": {"density_kg_m3": 1e6}}"#),
             "grain.density_kg_m3"
         );
-        for json in [
-            r#"{"spacing_m": 1e-12}"#,
-            r#"{"surface_width_dg": 1e6}"#,
-            r#"{"grain": {"diameter_m": 1}}"#,
+        for (json, field) in [
+            (r#"{"spacing_m": 1e-12}"#, "spacing_m"),
+            (r#"{"grain": {"diameter_m": 1}}"#, "spacing_m"),
+            (r#"{"surface_width_dg": 1e6}"#, "surface_width_dg"),
+            (
+                r#"{"surface_width_dg": 90, "surface_depth_dg": 90, "spacing_m": 1e-6}"#,
+                "spacing_m",
+            ),
         ] {
-            assert_eq!(field_of(json), "spacing_m", "{json}");
-            assert!(rule_of(json).contains("particles"), "{json}");
+            assert_eq!(field_of(json), field, "{json}");
         }
+        assert!(
+            rule_of(r#"{"surface_width_dg": 90, "surface_depth_dg": 90, "spacing_m": 1e-6}"#)
+                .contains("gives a surface of")
+        );
+        // Cells, and impacts in all.
+        let many: Vec<f64> = (1..=200).map(|v| v as f64).collect();
+        let json = serde_json::json!({"velocity_m_s": many, "grain": {"density_kg_m3": (1..=60).map(|v| v as f64 * 100.0).collect::<Vec<_>>()}, "samples": 1}).to_string();
+        assert_eq!(field_of(&json), "velocity_m_s");
+        assert!(rule_of(&json).contains("cells, more than the limit of 10000"));
+        let json = r#"{"samples": 1000, "impacts": 100000}"#;
+        assert_eq!(field_of(json), "impacts");
+        assert!(rule_of(json).contains("more than the limit of 100000000"));
         // The seed's finest scene stays well inside.
         parse(r#"{"spacing_m": 7.8125e-6, "velocity_m_s": 1000}"#)
             .unwrap()

@@ -227,6 +227,10 @@ const FIXED_LAYERS: f64 = 4.0;
 pub const MAX_VELOCITY_M_S: f64 = 1000.0;
 /// Densest grain the impact scene takes (kg/m³): above osmium, the densest element.
 pub const MAX_DENSITY_KG_M3: f64 = 25_000.0;
+/// Finest resolution the impact scene takes, in particles per grain diameter.
+pub const MAX_PPD: f64 = 512.0;
+/// Widest or deepest surface the impact scene takes, in grain diameters.
+pub const MAX_SURFACE_DG: f64 = 100.0;
 /// Most particles a surface may hold: a guard against a typo in the spacing or the surface
 /// size that would exhaust a worker's memory (the seed's scene has about 6 000).
 pub const MAX_SURFACE_PARTICLES: f64 = 5e5;
@@ -341,7 +345,27 @@ impl ImpactParams {
                 ),
             ));
         }
+        // Each size is bounded alone first, so the error names the field that is out of line.
         let ppd = self.grain_diameter_m / self.spacing_m;
+        InputError::require_at_most(
+            "spacing_m",
+            ppd,
+            MAX_PPD,
+            "particles per grain diameter (grain_diameter_m / spacing_m)",
+            "the seed's finest is 32",
+        )?;
+        for (field, v) in [
+            ("surface_width_dg", self.surface_width_dg),
+            ("surface_depth_dg", self.surface_depth_dg),
+        ] {
+            InputError::require_at_most(
+                field,
+                v,
+                MAX_SURFACE_DG,
+                "grain diameters",
+                "the seed's surface is 4 × 1.5",
+            )?;
+        }
         let particles = self.surface_width_dg * self.surface_depth_dg * ppd * ppd;
         if particles > MAX_SURFACE_PARTICLES {
             return Err(InputError::new(
@@ -355,10 +379,11 @@ impl ImpactParams {
             .validate()
             .map_err(|e| InputError::new(format!("material.{}", e.field), e.rule))?;
         let k = self.numerics.contact_stiffness_scale;
-        if !(k.is_finite() && k > 0.0) {
+        // The stability map spans 0.25 to 256 by default; beyond 1000 is a typo.
+        if !(k.is_finite() && k > 0.0 && k <= 1e3) {
             return Err(InputError::new(
                 "numerics.contact_stiffness_scale",
-                format!("must be > 0, got {k}"),
+                format!("must lie in (0, 1000], got {}", InputError::shown(k)),
             ));
         }
         self.settings()

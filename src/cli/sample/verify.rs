@@ -27,11 +27,35 @@ pub struct Args {
     /// Write one SVG chart per case into this folder.
     #[arg(long)]
     charts: Option<PathBuf>,
-    /// Run only the cases whose name contains this text (slope, sliding, hertz, impact,
-    /// hourglass, jet).
+    /// Run only the cases whose name contains this text, case-insensitive: a group (slope,
+    /// sliding, hertz, impact, hourglass, jet) runs alone; any other text runs every group and
+    /// keeps the rows whose case holds it (e.g. hydrostatic).
     #[arg(long)]
     only: Option<String>,
 }
+
+/// How each group's case names begin (`docs/verification.md`), so `--only` can pick the
+/// group of a case without running the others.
+const CASE_NAMES: [(&str, &[&str]); 6] = [
+    ("slope", &["slope_slider"]),
+    ("sliding", &["controlled_sliding"]),
+    ("hertz", &["hertz"]),
+    ("impact", &["elastic_impact"]),
+    ("hourglass", &["zero_energy_modes"]),
+    (
+        "jet",
+        &[
+            "jet_hugoniot",
+            "jet_dem_drop",
+            "jet_restitution",
+            "jet_hydrostatic",
+            "jet_settling",
+            "jet_coupling",
+            "jet_wall",
+            "jet_rc",
+        ],
+    ),
+];
 
 /// Runs the cases; exits 1 if any row fails its tolerance, except rows marked `expected_fail`
 /// (they show where a method fails, and failing is their point).
@@ -58,7 +82,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let wall = if a.quick { (16, 400.0) } else { (24, 400.0) };
     // The coupling-radius study's jet: the paper's d_ini = 50 µm is 20 across its 1 mm jet.
     let rc = jet_grain::RcScene::new(if a.quick { 16 } else { 20 }, 500.0, 1.0);
-    let want = |name: &str| a.only.as_deref().is_none_or(|o| name.contains(o));
+    let only = a.only.as_deref().map(str::to_lowercase);
+    let want = |name: &str| only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
     let cases: [(&str, Case); 6] = [
         ("slope", Box::new(move || slope::run(slope_n))),
@@ -71,25 +96,50 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Box::new(move || jet::run(jet_dt, jet_n, jet_settle, wall, rc)),
         ),
     ];
-    if let Some(o) = &a.only {
-        if !cases.iter().any(|(name, _)| want(name)) {
-            let names: Vec<&str> = cases.iter().map(|(name, _)| *name).collect();
-            bail!(
-                "--only: `{o}` is in no case group's name; the groups are {}",
-                names.join(", ")
-            );
-        }
+    // A text no group's name holds names cases inside the groups (`hydrostatic`,
+    // `jet_wall_force`): the groups whose cases can hold it run, and only the rows whose case
+    // holds it are kept.
+    let by_case = !cases.iter().any(|(name, _)| want(name));
+    let holds = |group: &str| {
+        CASE_NAMES
+            .iter()
+            .filter(|(g, _)| *g == group)
+            .flat_map(|(_, names)| names.iter())
+            .any(|n| want(n) || only.as_deref().is_some_and(|o| o.starts_with(n)))
+    };
+    if by_case && !cases.iter().any(|(name, _)| holds(name)) {
+        bail!(
+            "--only: `{}` is in no case's name; the groups are {} and their cases start {}",
+            a.only.as_deref().unwrap_or_default(),
+            cases.map(|(name, _)| name).join(", "),
+            CASE_NAMES
+                .iter()
+                .flat_map(|(_, names)| names.iter())
+                .copied()
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
     }
     // The folder is made before the cases run, so a bad path costs nothing.
     if let Some(dir) = &a.charts {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     for (name, f) in cases.iter() {
-        if !want(name) {
+        if !(if by_case { holds(name) } else { want(name) }) {
             continue;
         }
         eprintln!("running {name} ...");
         rep.extend(f().with_context(|| format!("case {name}"))?);
+    }
+    if by_case {
+        rep.rows.retain(|r| want(&r.case.to_lowercase()));
+        rep.charts.retain(|c| want(&c.name.to_lowercase()));
+        if rep.rows.is_empty() {
+            bail!(
+                "--only: `{}` is in no case's name",
+                a.only.as_deref().unwrap_or_default()
+            );
+        }
     }
     if a.json {
         say!("{}", serde_json::to_string_pretty(&rep.rows)?);

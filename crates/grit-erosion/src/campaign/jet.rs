@@ -19,7 +19,8 @@ use serde_json::{Map, Value};
 
 use super::json::{self, count, field_path, reject_unknown};
 use super::{
-    check_list_len, check_sweep, err, job_count, job_seed, MaterialSpec, SpecError, Sweep, MAX_JOBS,
+    check_cells, check_list_len, check_sweep, err, job_count, job_seed, MaterialSpec, SpecError,
+    Sweep, MAX_JOBS,
 };
 use crate::jet::JetParams;
 
@@ -190,6 +191,10 @@ pub struct JetJob {
 /// The swept dimensions in expansion order, fastest first: (spec field, number of values).
 type Dims = [(&'static str, usize); 6];
 
+/// Most slices one jet campaign may plan: a slice is seconds to minutes of a core, so this is
+/// CPU-years, a guard against a typo that would fill the database.
+pub const MAX_SLICES_TOTAL: u128 = 10_000_000;
+
 impl JetCampaignSpec {
     /// Parses JSON text; errors name the field (`(json)` for text that is not JSON,
     /// `(campaign)` for JSON that is not an object, `null` included).
@@ -317,13 +322,24 @@ impl JetCampaignSpec {
                 format!("the campaign expands into {jobs} jobs, more than the limit of {MAX_JOBS}"),
             ));
         }
+        check_cells(&self.dims())?;
         // The run's own rules (resolution, sizes, slices) live with JetParams; each cell is
         // checked through it and the error names the spec field that set the value.
+        let mut slices = 0u128;
         for cell in self.cells_unchecked() {
             cell.params.validate().map_err(|e| {
                 let idx = self.sweep_indices(cell.index);
                 err(self.spec_field(&e.field, &idx), e.rule)
             })?;
+            slices += cell.slices as u128 * self.samples as u128;
+        }
+        if slices > MAX_SLICES_TOTAL {
+            return Err(err(
+                "time_ms",
+                format!(
+                    "the campaign plans {slices} slices (cells × samples × time_ms / slice_ms), more than the limit of {MAX_SLICES_TOTAL}"
+                ),
+            ));
         }
         Ok(())
     }

@@ -239,6 +239,13 @@ impl JetParams {
             "the seed's longest run is 60 ms",
         )?;
         InputError::require_at_most(
+            "mass_flow_kg_s",
+            self.mass_flow_kg_s,
+            1.0,
+            "kg/s",
+            "the paper's runs go to 0.07 kg/s",
+        )?;
+        InputError::require_at_most(
             "velocity_m_s",
             self.velocity_m_s,
             MAX_JET_SPEED_M_S,
@@ -272,6 +279,13 @@ impl JetParams {
     /// Parses and checks a JSON object of parameters (fields left out keep their defaults);
     /// the error names the field at fault.
     pub fn from_json(text: &str) -> Result<JetParams, InputError> {
+        // Serde would read a JSON array as the struct's fields in order; only objects are scenes.
+        if !text.trim_start().starts_with('{') {
+            return Err(InputError::new(
+                "(scene)",
+                "must be a JSON object of JetParams fields",
+            ));
+        }
         let de = &mut serde_json::Deserializer::from_str(text);
         let p: JetParams = serde_path_to_error::deserialize(de)
             .map_err(|e| InputError::new(e.path().to_string(), e.inner().to_string()))?;

@@ -313,4 +313,13 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
         beat.impacts_done, 1,
         "the whole surface is the bound, and allowed"
     );
+    // The bound holds for the sample's loss in all, not per impact.
+    assert_eq!(
+        refused(placeholder_record(2, grain, surface * 1e-3)).await,
+        "impacts[0].mass_loss_kg"
+    );
+    // The record's two copies of the loss must agree.
+    let mut two = placeholder_record(2, grain, 0.0);
+    two.outcome.mass_loss_kg = 1e-9;
+    assert_eq!(refused(two).await, "impacts[0].mass_loss_kg");
 }

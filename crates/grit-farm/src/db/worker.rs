@@ -117,7 +117,18 @@ pub(super) struct NewImpact {
 fn serialised(impacts: &[ImpactRecord]) -> Result<Vec<NewImpact>> {
     impacts
         .iter()
-        .map(|rec| {
+        .enumerate()
+        .map(|(i, rec)| {
+            // The record says the loss twice; both come from one number in a worker.
+            if rec.mass_loss_kg.to_bits() != rec.outcome.mass_loss_kg.to_bits() {
+                return Err(Error::invalid(
+                    format!("impacts[{i}].mass_loss_kg"),
+                    format!(
+                        "must equal outcome.mass_loss_kg ({:e}), got {:e}",
+                        rec.outcome.mass_loss_kg, rec.mass_loss_kg
+                    ),
+                ));
+            }
             Ok(NewImpact {
                 impact: rec.impact,
                 grain_mass_kg: rec.grain_mass_kg,
@@ -730,6 +741,16 @@ fn is_next(unit: &str, n: u32, done: u32, planned: u32, field: String) -> Result
     Ok(true)
 }
 
+/// The mass job `job_id`'s stored impacts lost, in all (kg/m).
+async fn stored_loss(tx: &mut Transaction<'static, Sqlite>, job_id: i64) -> Result<f64> {
+    let sum: Option<f64> =
+        sqlx::query_scalar("SELECT SUM(mass_loss_kg) FROM impacts WHERE job_id = ?")
+            .bind(job_id)
+            .fetch_one(&mut **tx)
+            .await?;
+    Ok(sum.unwrap_or(0.0))
+}
+
 /// The scene a job's cell stored at submission (`cells.params`).
 fn stored_params<T: serde::de::DeserializeOwned>(job_id: i64, params: &str) -> Result<T> {
     serde_json::from_str(params)
@@ -750,6 +771,8 @@ async fn store_impacts(
     let mut done = held.done;
     let mut new = Vec::with_capacity(impacts.len());
     let mut scene = None;
+    // The sample's loss so far, read once the first new record needs it.
+    let mut lost: Option<f64> = None;
     for (i, rec) in impacts.iter().enumerate() {
         let field = |name: &str| format!("impacts[{i}].{name}");
         if !is_next("impact", rec.impact, done, held.planned, field("impact"))? {
@@ -771,12 +794,23 @@ async fn store_impacts(
             ));
         }
         let surface = p.surface_mass_kg_m();
-        if !(rec.mass_loss_kg.is_finite() && (0.0..=surface).contains(&rec.mass_loss_kg)) {
+        if !(rec.mass_loss_kg.is_finite() && rec.mass_loss_kg >= 0.0) {
+            return Err(Error::invalid(
+                field("mass_loss_kg"),
+                format!("must be finite and ≥ 0, got {:e}", rec.mass_loss_kg),
+            ));
+        }
+        let before = match lost {
+            Some(l) => l,
+            None => *lost.insert(stored_loss(tx, job_id).await?),
+        };
+        lost = Some(before + rec.mass_loss_kg);
+        if before + rec.mass_loss_kg > surface {
             return Err(Error::invalid(
                 field("mass_loss_kg"),
                 format!(
-                    "must be finite, ≥ 0 and at most the surface's mass {surface:e} kg/m, got {:e}",
-                    rec.mass_loss_kg
+                    "brings the sample's loss to {:e} kg/m, more than the surface's mass {surface:e} kg/m",
+                    before + rec.mass_loss_kg
                 ),
             ));
         }

@@ -143,7 +143,9 @@ async fn json_errors(resp: axum::response::Response) -> axum::response::Response
         .await
         .map(|b| String::from_utf8_lossy(&b).trim().to_string())
         .unwrap_or_default();
-    let error = if !text.is_empty() {
+    let error = if status == axum::http::StatusCode::PAYLOAD_TOO_LARGE {
+        "the body is over the coordinator's limit (grit serve --max-spec-bytes for campaign specs, --max-worker-bytes for worker requests)".into()
+    } else if !text.is_empty() {
         text
     } else if status == axum::http::StatusCode::METHOD_NOT_ALLOWED {
         // The method router sets `Allow` outside this layer.

@@ -123,7 +123,7 @@ impl Settings {
                 "hourglass",
                 format!(
                     "must lie in [0, {MAX_HOURGLASS}] (the seed's is 0.1), got {}",
-                    self.hourglass
+                    InputError::shown(self.hourglass)
                 ),
             ));
         }
