@@ -24,12 +24,20 @@ pub const MAX_THREADS: usize = 1024;
 /// Longest time a seconds flag takes (about 116 days): any more is a typo in the units.
 pub const MAX_SECONDS: f64 = 1e7;
 
-/// Parser of `--threads` and `--workers`: a whole number from 1 to [`MAX_THREADS`].
-pub fn thread_count(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
-        _ => Err(format!("must be a whole number from 1 to {MAX_THREADS}")),
+/// A whole number in [`lo`, `hi`], or the rule in words: the integer flags' parsers.
+fn whole_in<T>(s: &str, lo: T, hi: T) -> Result<T, String>
+where
+    T: std::str::FromStr + PartialOrd + std::fmt::Display,
+{
+    match s.parse::<T>() {
+        Ok(n) if lo <= n && n <= hi => Ok(n),
+        _ => Err(format!("must be a whole number from {lo} to {hi}")),
     }
+}
+
+/// Parser of `--threads`, `--workers` and `--clients`: 1 to [`MAX_THREADS`].
+pub fn thread_count(s: &str) -> Result<usize, String> {
+    whole_in(s, 1, MAX_THREADS)
 }
 
 /// Parser of a duration flag: a finite number of seconds, > 0 and at most [`MAX_SECONDS`].
@@ -44,45 +52,27 @@ pub fn seconds(s: &str) -> Result<f64, String> {
 
 /// Parser of a count that must be at least 1 (`--checkpoint-every`, `--max-attempts`).
 pub fn at_least_one(s: &str) -> Result<u32, String> {
-    match s.parse::<u32>() {
-        Ok(n) if n >= 1 => Ok(n),
-        _ => Err(format!("must be a whole number from 1 to {}", u32::MAX)),
-    }
+    whole_in(s, 1, u32::MAX)
 }
 
 /// Parser of an impact count: 1 to the most a sample may be planned with.
 pub fn impact_count(s: &str) -> Result<u32, String> {
-    use grit_erosion::campaign::MAX_IMPACTS;
-    match s.parse::<u32>() {
-        Ok(n) if (1..=MAX_IMPACTS).contains(&n) => Ok(n),
-        _ => Err(format!("must be a whole number from 1 to {MAX_IMPACTS}")),
-    }
+    whole_in(s, 1, grit_erosion::campaign::MAX_IMPACTS)
 }
 
 /// Parser of impacts taken before a measured one: 0 to the most a sample may be planned with.
 pub fn impacts_before(s: &str) -> Result<u32, String> {
-    use grit_erosion::campaign::MAX_IMPACTS;
-    match s.parse::<u32>() {
-        Ok(n) if n <= MAX_IMPACTS => Ok(n),
-        _ => Err(format!("must be a whole number from 0 to {MAX_IMPACTS}")),
-    }
+    whole_in(s, 0, grit_erosion::campaign::MAX_IMPACTS)
 }
 
 /// Parser of a benchmark's repeats: 1 to 1000.
 pub fn repeat_count(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(n) if (1..=1000).contains(&n) => Ok(n),
-        _ => Err("must be a whole number from 1 to 1000".into()),
-    }
+    whole_in(s, 1, 1000)
 }
 
-/// Parser of a request-size limit: 1 KiB (the smallest request) to 4 GiB.
+/// Parser of a request-size limit in bytes: 1 KiB (the smallest request) to 4 GiB.
 pub fn body_bytes(s: &str) -> Result<usize, String> {
-    const MAX: usize = 4 << 30;
-    match s.parse::<usize>() {
-        Ok(n) if (1024..=MAX).contains(&n) => Ok(n),
-        _ => Err(format!("must be a number of bytes from 1024 to {MAX}")),
-    }
+    whole_in(s, 1024, 4 << 30)
 }
 
 /// The rayon pool of `--threads`: that many threads, all cores when `None`.
