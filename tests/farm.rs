@@ -388,6 +388,7 @@ async fn auth_validation_size_and_unknown_ids() {
     for body in [
         serde_json::json!({"worker": 5}),
         serde_json::json!({"worker": ""}),
+        serde_json::json!({"worker": "   "}),
     ] {
         let r = claim(body.clone()).await.unwrap();
         assert_eq!(status_of(&r), 422, "{body}");

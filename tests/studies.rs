@@ -154,7 +154,7 @@ fn sweep_runs_two_variants_resumes_and_charts() {
 fn studies_refuse_bad_input_naming_the_option() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let cases: [(&[&str], &str); 24] = [
+    let cases: [(&[&str], &str); 25] = [
         (
             &["bench", "impact", "--repeat", "0"],
             "'--repeat <REPEAT>': must be a whole number from 1 to 1000",
@@ -215,6 +215,10 @@ fn studies_refuse_bad_input_naming_the_option() {
         (
             &["run", "examples/quick.json", "--workers", "100000"],
             "'--workers <WORKERS>': must be a whole number from 1 to 1024",
+        ),
+        (
+            &["compare", "tests/data/quick-results.json", "--window", "81-100000"],
+            "--window 81-100000: no cell of tests/data/quick-results.json has those impacts",
         ),
         (
             &["sample", "--angle", "-5"],

@@ -70,6 +70,12 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
             .map(|(name, mut input)| {
                 let (r, notes) = grit_erosion::compare::on_window(&input.results, first, last)
                     .map_err(|e| anyhow!("{name}: {e}"))?;
+                if r.cells.is_empty() {
+                    return Err(anyhow!(
+                        "--window {first}-{last}: no cell of {name} has those impacts ({})",
+                        notes.join("; ")
+                    ));
+                }
                 input.results = r;
                 window_notes.extend(notes.into_iter().map(|n| format!("{name}: {n}")));
                 Ok((name, input))

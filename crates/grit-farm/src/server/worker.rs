@@ -177,8 +177,11 @@ async fn check_checkpoint(
     responses((status = 200, body = ClaimedJob), (status = 204, description = "no job queued"), (status = 401)),
     security(("worker_token" = [])))]
 async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -> Result<Response> {
-    if req.worker.is_empty() || req.worker.len() > 200 {
-        return Err(Error::invalid("worker", "must be 1 to 200 characters"));
+    if req.worker.trim().is_empty() || req.worker.len() > 200 {
+        return Err(Error::invalid(
+            "worker",
+            "must be 1 to 200 characters, not all blank",
+        ));
     }
     Ok(match s.store.claim(&req.worker).await? {
         Some(job) => Json(job).into_response(),
