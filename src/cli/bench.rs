@@ -292,12 +292,6 @@ fn impact(
         full_grain,
         full_flight,
     } = scene;
-    if threads == 0 {
-        bail!("--threads: must be at least 1");
-    }
-    if repeat == 0 {
-        bail!("--repeat: must be at least 1");
-    }
     let mut params = studies::scene(angle, spacing_m);
     params.numerics.engine.rigid_shell &= !full_grain;
     params.numerics.skip_flight &= !full_flight;

@@ -173,7 +173,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
             .workers
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         threads_per_worker: a.threads,
-        checkpoint_every: a.checkpoint_every.max(1),
+        checkpoint_every: a.checkpoint_every,
         raw: a.raw,
     };
     let stop = Stop::default();

@@ -75,11 +75,9 @@ pub fn body_bytes(s: &str) -> Result<usize, String> {
     whole_in(s, 1024, 4 << 30)
 }
 
-/// The rayon pool of `--threads`: that many threads, all cores when `None`.
+/// The rayon pool of `--threads` (1 or more, by its parser): that many threads, all cores
+/// when `None`.
 pub fn pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
-    if threads == Some(0) {
-        bail!("--threads: must be at least 1");
-    }
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()

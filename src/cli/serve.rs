@@ -140,23 +140,11 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
 /// `grit work`: leases and runs jobs until stopped (or idle with `--exit-when-idle`).
 pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
     let token = read_token(a.remote.token, a.remote.token_file, "token")?;
-    if !(a.request_timeout_s.is_finite() && a.request_timeout_s > 0.0) {
-        bail!(
-            "--request-timeout-s must be > 0, got {}",
-            a.request_timeout_s
-        );
-    }
     let client = Client::with_timeout(
         &a.remote.coordinator,
         token,
         Duration::from_secs_f64(a.request_timeout_s),
     )?;
-    if a.checkpoint_every == 0 {
-        bail!("--checkpoint-every must be at least 1");
-    }
-    if !(a.poll_s.is_finite() && a.poll_s > 0.0) {
-        bail!("--poll-s must be > 0");
-    }
     let opts = WorkerOptions {
         name: a.name.unwrap_or_else(worker::default_name),
         threads: a.threads,

@@ -12,8 +12,7 @@
 mod common;
 
 use common::{arg, short_run};
-use grit_sph::coupling::{self, FluidView};
-use grit_sph::{Vector, World};
+use grit_sph::{coupling, World};
 
 /// Steps between samples: a grain crosses a spacing in about ten steps at the jet's speed.
 const EVERY: u64 = 10;
@@ -47,53 +46,13 @@ impl Band {
 }
 
 /// Each grain's ε_i and its height above `surface_y` (m): the coupling's own Shepard average
-/// (`coupling::coupling_forces`' `grain_fluid`), from the porosity and pairs the coupling
-/// stage finds at these positions. Grains with no fluid within R_c are left out.
+/// (`World::grain_fluid`). Grains with no fluid within R_c are left out.
 fn grain_porosities(w: &World, surface_y: f64) -> Result<Vec<(f64, f64)>, String> {
-    let Some(ab) = w.abrasives() else {
-        return Ok(Vec::new());
-    };
-    let Some(fb) = ab.fluid_body else {
-        return Ok(Vec::new());
-    };
-    let fluid_props = w.bodies()[fb]
-        .fluid()
-        .ok_or("the coupled body is not a fluid")?;
-    let p = w.particles();
-    let fluid: Vec<usize> = (0..p.len()).filter(|&i| p.body[i] as usize == fb).collect();
-    let gather_v = |a: &[Vector]| -> Vec<Vector> { fluid.iter().map(|&i| a[i]).collect() };
-    let gather_s = |a: &[f64]| -> Vec<f64> { fluid.iter().map(|&i| a[i]).collect() };
-    let (pos, vel, mass, rho_bar) = (
-        gather_v(&p.pos),
-        gather_v(&p.vel),
-        gather_s(&p.mass),
-        gather_s(&p.rho),
-    );
-    let grains = &ab.dem.grains;
-    let e = |e: grit_sph::InputError| e.to_string();
-    let pairs = coupling::find_pairs(&ab.coupling, &pos, grains).map_err(e)?;
-    let eps = coupling::porosity(&ab.coupling, fluid.len(), grains, &pairs).values;
-    // The porosity does not depend on θ; the forces computed beside it are not used.
-    let theta = vec![Vector::zeros(); fluid.len()];
-    let view = FluidView {
-        position: &pos,
-        velocity: &vel,
-        mass: &mass,
-        rho_bar: &rho_bar,
-    };
-    let f = coupling::coupling_forces(
-        &ab.coupling,
-        fluid_props,
-        view,
-        &eps,
-        &theta,
-        grains,
-        &pairs,
-    )
-    .map_err(e)?;
+    let seen = w.grain_fluid().map_err(|e| e.to_string())?;
+    let grains = w.abrasives().map_or(&[][..], |a| &a.dem.grains[..]);
     Ok(grains
         .iter()
-        .zip(&f.grain_fluid)
+        .zip(&seen)
         .filter(|(_, gf)| gf.shepard > 0.0)
         .map(|(g, gf)| (gf.porosity, g.pos.y - surface_y))
         .collect())

@@ -63,9 +63,7 @@ pub const MAX_IMPACTS_TOTAL: u128 = 100_000_000;
 
 /// The rule on the cell count: at most [`MAX_CELLS`], named on the longest list of `dims`.
 fn check_cells(dims: &[(&'static str, usize)]) -> Result<(), SpecError> {
-    let cells = dims
-        .iter()
-        .fold(1u128, |n, (_, len)| n.saturating_mul(*len as u128));
+    let cells = job_count(dims.iter().map(|(_, len)| *len), 1);
     if cells > MAX_CELLS as u128 {
         let longest = dims.iter().max_by_key(|(_, len)| *len).map_or("", |d| d.0);
         return Err(err(

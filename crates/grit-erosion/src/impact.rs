@@ -235,6 +235,25 @@ pub const MAX_SURFACE_DG: f64 = 100.0;
 /// size that would exhaust a worker's memory (the seed's scene has about 6 000).
 pub const MAX_SURFACE_PARTICLES: f64 = 5e5;
 
+/// A scene (`ImpactParams`, `JetParams`: `kind`) read from a JSON object, fields left out at
+/// their defaults, the error naming the field at fault. Not validated: flags may still
+/// override fields. Serde would read a JSON array as the struct's fields in order, so only an
+/// object is a scene.
+pub fn scene_from_json<T: serde::de::DeserializeOwned>(
+    text: &str,
+    kind: &str,
+) -> Result<T, InputError> {
+    if !text.trim_start().starts_with('{') {
+        return Err(InputError::new(
+            "(scene)",
+            format!("must be a JSON object of {kind} fields"),
+        ));
+    }
+    let de = &mut serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(de)
+        .map_err(|e| InputError::new(e.path().to_string(), e.inner().to_string()))
+}
+
 /// The bound every scene keeps on its grains' density ([`MAX_DENSITY_KG_M3`]).
 pub(crate) fn check_grain_density(rho: f64) -> Result<(), InputError> {
     InputError::require_at_most(

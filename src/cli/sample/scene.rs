@@ -71,18 +71,8 @@ impl SceneArgs {
             Some(path) => {
                 let text = std::fs::read_to_string(path)
                     .with_context(|| format!("reading {}", path.display()))?;
-                let v: serde_json::Value = serde_json::from_str(&text)
-                    .with_context(|| format!("scene {}", path.display()))?;
-                if !v.is_object() {
-                    bail!(
-                        "scene {}: must be a JSON object of ImpactParams fields",
-                        path.display()
-                    );
-                }
-                let de = &mut serde_json::Deserializer::from_str(&text);
-                serde_path_to_error::deserialize(de).map_err(|e| {
-                    anyhow::anyhow!("scene {}: {}: {}", path.display(), e.path(), e.inner())
-                })?
+                grit_erosion::impact::scene_from_json(&text, "ImpactParams")
+                    .with_context(|| format!("scene {}", path.display()))?
             }
             None => ImpactParams::default(),
         };

@@ -279,16 +279,7 @@ impl JetParams {
     /// Parses and checks a JSON object of parameters (fields left out keep their defaults);
     /// the error names the field at fault.
     pub fn from_json(text: &str) -> Result<JetParams, InputError> {
-        // Serde would read a JSON array as the struct's fields in order; only objects are scenes.
-        if !text.trim_start().starts_with('{') {
-            return Err(InputError::new(
-                "(scene)",
-                "must be a JSON object of JetParams fields",
-            ));
-        }
-        let de = &mut serde_json::Deserializer::from_str(text);
-        let p: JetParams = serde_path_to_error::deserialize(de)
-            .map_err(|e| InputError::new(e.path().to_string(), e.inner().to_string()))?;
+        let p: JetParams = crate::impact::scene_from_json(text, "JetParams")?;
         p.validate()?;
         Ok(p)
     }

@@ -71,23 +71,20 @@ pub(crate) fn grain_porosity(
     Ok(CouplingFrame { fluid, pairs })
 }
 
-/// The coupling forces of eqs. 42–50: F_af onto `loads` of each grain, and the reaction F_fa/m_a
-/// onto the acceleration `acc` of each fluid particle. `theta` is θ_a of eq. 43 per world
-/// particle (pressure and laminar parts of the fluid's acceleration), `porosity` per world
-/// particle.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn coupling_forces(
+/// The coupling of eqs. 42–50 at the particles' present state: the coupled fluid's particles
+/// of `frame` gathered into a [`FluidView`] with their `porosity` and θ_a (`theta`, pressure
+/// and laminar parts of the fluid's acceleration), both per world particle. None when no
+/// grain has fluid within R_c.
+pub(crate) fn evaluate_coupling(
     p: &Particles,
     ab: &Abrasives,
     fluid_props: &crate::fluid::Fluid,
     frame: &CouplingFrame,
     porosity: &[f64],
     theta: &[Vector],
-    acc: &mut [Vector],
-    loads: &mut GrainLoads,
-) -> Result<(), InputError> {
+) -> Result<Option<coupling::CouplingForces>, InputError> {
     if frame.pairs.is_empty() {
-        return Ok(());
+        return Ok(None);
     }
     let idx = &frame.fluid;
     let gather_v = |a: &[Vector]| -> Vec<Vector> { idx.iter().map(|&i| a[i]).collect() };
@@ -100,7 +97,7 @@ pub(crate) fn coupling_forces(
         mass: &mass,
         rho_bar: &rho_bar,
     };
-    let f = coupling::coupling_forces(
+    coupling::coupling_forces(
         &ab.coupling,
         fluid_props,
         view,
@@ -108,11 +105,30 @@ pub(crate) fn coupling_forces(
         &theta_f,
         &ab.dem.grains,
         &frame.pairs,
-    )?;
+    )
+    .map(Some)
+}
+
+/// The coupling forces of eqs. 42–50 ([`evaluate_coupling`]): F_af onto `loads` of each grain,
+/// and the reaction F_fa/m_a onto the acceleration `acc` of each fluid particle.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn coupling_forces(
+    p: &Particles,
+    ab: &Abrasives,
+    fluid_props: &crate::fluid::Fluid,
+    frame: &CouplingFrame,
+    porosity: &[f64],
+    theta: &[Vector],
+    acc: &mut [Vector],
+    loads: &mut GrainLoads,
+) -> Result<(), InputError> {
+    let Some(f) = evaluate_coupling(p, ab, fluid_props, frame, porosity, theta)? else {
+        return Ok(());
+    };
     for (load, on) in loads.force.iter_mut().zip(&f.on_grains) {
         *load += on;
     }
-    for (&i, on) in idx.iter().zip(&f.on_fluid) {
+    for (&i, on) in frame.fluid.iter().zip(&f.on_fluid) {
         acc[i] += on / p.mass[i];
     }
     Ok(())

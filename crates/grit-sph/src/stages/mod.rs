@@ -18,7 +18,8 @@ mod stress;
 mod time_step;
 
 pub(crate) use abrasives::{
-    advance, coupling_forces, fresh_loads, grain_porosity, penalty, CouplingFrame, GrainLoads,
+    advance, coupling_forces, evaluate_coupling, fresh_loads, grain_porosity, penalty,
+    CouplingFrame, GrainLoads,
 };
 pub(crate) use ceiling::ceiling;
 pub use ceiling::CeilingPass;

@@ -9,6 +9,7 @@ use crate::coupling::{disc_area, CouplingParams};
 use crate::dem::{Dem, Grain};
 use crate::error::InputError;
 use crate::math::Vector;
+use crate::stages;
 
 /// The abrasive–target penalty contact's constants (the AWJ paper eq. 13); its range d_ini is
 /// the world's particle spacing.
@@ -196,6 +197,31 @@ impl World {
     /// The grains and their coupling, if the world has any.
     pub fn abrasives(&self) -> Option<&Abrasives> {
         self.abrasives.as_ref()
+    }
+
+    /// The fluid as each grain sees it now (ε_i, v̄_f and S_i of the AWJ paper eqs. 45, 46,
+    /// 50), from the porosity and pairs the step's coupling stage would find at these positions;
+    /// empty without abrasives or a coupled fluid, S_i = 0 for a grain with no fluid within R_c.
+    pub fn grain_fluid(&self) -> Result<Vec<crate::coupling::GrainFluid>, InputError> {
+        let Some(ab) = &self.abrasives else {
+            return Ok(Vec::new());
+        };
+        let Some(fb) = ab.fluid_body else {
+            return Ok(Vec::new());
+        };
+        let fluid = self.bodies[fb].fluid().expect("checked by set_abrasives");
+        let p = &self.particles;
+        let mut porosity = Vec::new();
+        let frame = stages::grain_porosity(p, ab, &mut porosity)?;
+        // ε_i and v̄_f do not depend on θ; the forces computed beside them are not used.
+        let theta = vec![Vector::zeros(); p.len()];
+        let f = stages::evaluate_coupling(p, ab, fluid, &frame, &porosity, &theta)?;
+        let none = crate::coupling::GrainFluid {
+            shepard: 0.0,
+            porosity: 1.0,
+            velocity: Vector::zeros(),
+        };
+        Ok(f.map_or_else(|| vec![none; ab.dem.grains.len()], |f| f.grain_fluid))
     }
 
     /// The grains' contact starts with the target and their grain-steps in contact since the
