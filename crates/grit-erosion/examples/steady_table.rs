@@ -1,34 +1,20 @@
-//! The steady-state check of every cell of a results file, as a markdown table:
-//! `cargo run --release -p grit-erosion --example steady_table -- RESULTS.json`.
+//! The steady-state check of every cell of a results file under this build's rule, beside
+//! the verdict the file stored, as a markdown table:
+//! `cargo run --release -p grit-erosion --example steady_table -- RESULTS.json…`.
 //!
-//! With a `raw` array (`grit run --raw`) the cells are aggregated again from their samples,
-//! so the check is complete. Without one only the mean series is there: the two slopes are
-//! printed with the first impact at which the mean lost mass (the earliest sample's
-//! incubation), and steadiness is left open.
+//! Files that store each sample's first loss are checked exactly; older files keep only the
+//! range of first losses, and where that range cannot tell whether the samples had incubated
+//! by the start of the rule's window the cell says "cannot tell".
 use std::process::ExitCode;
 
-use grit_erosion::aggregate::{aggregate_campaign, CampaignResults, CellInput, Impact};
-use grit_erosion::steady::{mean_series_slopes, SlopeFit};
-use grit_erosion::SLOPE_WINDOW;
-use serde::Deserialize;
-
-#[derive(Deserialize)]
-struct Raw {
-    cell: usize,
-    sample: u32,
-    impacts: Vec<Impact>,
-}
+use grit_erosion::aggregate::CampaignResults;
+use grit_erosion::steady::{reassess, SlopeFit, SteadyState};
 
 /// The slopes' difference in combined standard errors, the quantity of condition 1.
-fn z(last: Option<SlopeFit>, prev: Option<SlopeFit>) -> String {
-    match (last, prev) {
-        (Some(a), Some(b)) => {
-            let combined = (a.sem * a.sem + b.sem * b.sem).sqrt();
-            if combined > 0.0 {
-                format!("{:.1}", (a.value - b.value).abs() / combined)
-            } else {
-                "–".into()
-            }
+fn z(s: &SteadyState) -> String {
+    match (s.slope_last, s.slope_prev) {
+        (Some(a), Some(b)) if a.sem.hypot(b.sem) > 0.0 => {
+            format!("{:+.1}", (a.value - b.value) / a.sem.hypot(b.sem))
         }
         _ => "–".into(),
     }
@@ -40,104 +26,59 @@ fn show(fit: Option<SlopeFit>) -> String {
     })
 }
 
+fn verdict(s: Option<bool>) -> &'static str {
+    match s {
+        Some(true) => "yes",
+        Some(false) => "**no**",
+        None => "not in the file (incubation)",
+    }
+}
+
 fn run(path: &str) -> Result<(), String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
-    let mut value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
-    let raw = value.as_object_mut().and_then(|o| o.remove("raw"));
     let stored: CampaignResults =
-        serde_json::from_value(value).map_err(|e| format!("{path}: {e}"))?;
+        serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
+    println!("\n{path}\n");
     println!(
-        "| cell | impacts | first loss at impact (min–max, mean) | slope of the last 10 (mg/g) \
-         | slope of the 10 before (mg/g) | difference (combined SE) | steady |"
+        "| cell | samples | impacts | last 20 (mg/g) | previous 20 (mg/g) | difference (combined s.e.) \
+         | sees changes of | steady (stored rule) | steady (this rule) |"
     );
-    println!("|---|---|---|---|---|---|---|");
-    let Some(raw) = raw else {
-        for c in &stored.cells {
-            let (last, prev) = mean_series_slopes(&c.mean_series);
-            let first = c.mean_series.iter().find(|p| p.mass_loss_kg > 0.0);
-            println!(
-                "| {} | {} | from {} (earliest sample; no raw series) | {} | {} | {} | not checked |",
-                c.label(),
-                c.mean_series.len(),
-                first.map_or("never".into(), |p| p.impact.to_string()),
-                show(last),
-                show(prev),
-                z(last, prev)
-            );
-        }
-        return Ok(());
-    };
-    let raw: Vec<Raw> = serde_json::from_value(raw).map_err(|e| format!("{path}: raw: {e}"))?;
-    let mut cells: Vec<CellInput> = stored
-        .cells
-        .iter()
-        .map(|c| CellInput {
-            angle_deg: c.angle_deg,
-            shape: c.shape.clone(),
-            swept: c.swept.clone(),
-            planned_samples: c.samples_planned,
-            planned_impacts: c.impacts_planned,
-            samples: Vec::new(),
-        })
-        .collect();
-    for (i, r) in raw.into_iter().enumerate() {
-        let cell = cells
-            .get_mut(r.cell)
-            .ok_or_else(|| format!("{path}: raw[{i}].cell: {} is not a cell", r.cell))?;
-        cell.samples.push(grit_erosion::SampleInput {
-            sample: r.sample,
-            impacts: r.impacts,
-        });
-    }
-    let results = aggregate_campaign(&cells, SLOPE_WINDOW).map_err(|e| format!("{path}: {e}"))?;
-    for (c, old) in results.cells.iter().zip(&stored.cells) {
-        if c.erosion_mean != old.erosion_mean {
-            return Err(format!(
-                "{path}: cell {}: the raw series give erosion {:?}, the file {:?}",
-                c.label(),
-                c.erosion_mean,
-                old.erosion_mean
-            ));
-        }
-        let s = c
-            .steady_state
-            .as_ref()
-            .expect("aggregation checks every cell");
-        let incubation = s.incubation_impacts.map_or("none".into(), |i| {
-            format!("{}–{}, {:.1}", i.min, i.max, i.mean)
-        });
-        let without = match s.samples_without_loss {
-            0 => String::new(),
-            n => format!(" ({n} of {} none)", c.samples_reported),
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for c in &stored.cells {
+        let now = reassess(c);
+        let (last, prev, zz, sees) = match now.as_ref().map(|r| &r.state) {
+            Some(s) => (
+                show(s.slope_last),
+                show(s.slope_prev),
+                z(s),
+                s.detectable_change_rel
+                    .map_or("–".into(), |d| format!("{:.0} %", 100.0 * d)),
+            ),
+            None => ("–".into(), "–".into(), "–".into(), "–".into()),
         };
         println!(
-            "| {} | {} | {incubation}{without} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {last} | {prev} | {zz} | {sees} | {} | {} |",
             c.label(),
+            c.samples_reported,
             c.mean_series.len(),
-            show(s.slope_last10),
-            show(s.slope_prev10),
-            z(s.slope_last10, s.slope_prev10),
-            if s.steady { "yes" } else { "**no**" }
+            verdict(c.steady_state.as_ref().map(|s| s.steady)),
+            verdict(now.as_ref().and_then(|r| r.steady())),
         );
-    }
-    println!();
-    for w in results.unsteady_warnings() {
-        println!("{w}");
     }
     Ok(())
 }
 
 fn main() -> ExitCode {
-    let Some(path) = std::env::args().nth(1) else {
-        eprintln!("usage: steady_table RESULTS.json");
+    let paths: Vec<String> = std::env::args().skip(1).collect();
+    if paths.is_empty() {
+        eprintln!("usage: steady_table RESULTS.json…");
         return ExitCode::FAILURE;
-    };
-    match run(&path) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
+    }
+    for path in &paths {
+        if let Err(e) = run(path) {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            return ExitCode::FAILURE;
         }
     }
+    ExitCode::SUCCESS
 }

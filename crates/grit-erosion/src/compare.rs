@@ -622,10 +622,13 @@ mod tests {
             reason: String::new(),
             incubation_impacts: None,
             samples_without_loss: 0,
+            first_loss_impacts: Vec::new(),
             window_first_impact: None,
             samples_incubated_by_window: 0,
-            slope_last10: None,
-            slope_prev10: None,
+            points: 20,
+            slope_last: None,
+            slope_prev: None,
+            detectable_change_rel: None,
         });
         c
     }

@@ -2,14 +2,24 @@
 //!
 //! The paper takes erosion as the slope of the mass-loss curve once it is "rather steady and
 //! linear", after the incubation period. A campaign that stops too early still yields a
-//! last-20 slope, but one that mixes incubation with erosion. This module checks the cell's
-//! mean series (Fig. 10b) against three conditions, all of which must hold:
+//! last-20 slope, but one that mixes incubation with erosion, or one taken on a curve whose
+//! rate still changes. This module checks the cell's mean series (Fig. 10b) against three
+//! conditions, all of which must hold:
 //!
-//! 1. the least-squares slope over the last [`STEADY_POINTS`] impacts agrees with the slope
-//!    over the [`STEADY_POINTS`] before them within [`STEADY_SIGMAS`] combined standard errors;
+//! 1. the least-squares slope over the last [`STEADY_POINTS`] impacts (the erosion window)
+//!    agrees with the slope over the [`STEADY_POINTS`] before them within [`STEADY_SIGMAS`]
+//!    combined standard errors;
 //! 2. at least [`STEADY_INCUBATED_PERCENT`] % of the samples lost their first mass at or
-//!    before the first impact of that 20-impact window, so the window is past incubation;
+//!    before the first impact of those 2 × [`STEADY_POINTS`] impacts, so both slopes are past
+//!    incubation;
 //! 3. the last slope is positive.
+//!
+//! Each cell also reports the smallest change of rate the test can see,
+//! [`SteadyState::detectable_change_rel`]: [`STEADY_SIGMAS`] combined standard errors over the
+//! last slope. Comparing two 20-impact slopes instead of two 10-impact ones (the rule before
+//! 2026-11-26) halves the variance of each slope; on the committed 16-per-Dg campaigns it
+//! turns changes of 25–60 % of the rate visible that the 10-against-10 rule could not see
+//! (`docs/erosion.md`, *Steady state*).
 //!
 //! The standard error of a slope assumes that the per-impact losses are independent, which
 //! they are: each impact is its own random draw of aim and orientation. The cumulative series
@@ -19,18 +29,19 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::aggregate::{CentredSums, MeanPoint, SeriesPoint, SLOPE_WINDOW};
+use crate::aggregate::{CellResult, CentredSums, MeanPoint, SeriesPoint, SLOPE_WINDOW};
 
-/// Impacts in each of the two slopes compared: the last and the previous half of the
-/// paper's last-20 window (section 4).
-pub const STEADY_POINTS: usize = SLOPE_WINDOW / 2;
+/// Impacts in each of the two slopes compared: the paper's last-20 window (section 4) and the
+/// 20 impacts before it.
+pub const STEADY_POINTS: usize = SLOPE_WINDOW;
 
 /// Largest difference of the two slopes, in combined standard errors
 /// `√(se_last² + se_prev²)`, that still counts as agreement (about a 95 % two-sided test).
 pub const STEADY_SIGMAS: f64 = 2.0;
 
 /// Smallest share of samples, in percent, that must have lost mass by the first impact of
-/// the last-20 window: one sample in five may still be incubating (see `docs/erosion.md`).
+/// the two compared slopes: one sample in five may still be incubating (see
+/// `docs/erosion.md`).
 pub const STEADY_INCUBATED_PERCENT: usize = 80;
 
 /// A least-squares slope with its standard error.
@@ -66,14 +77,32 @@ pub struct SteadyState {
     /// Reported samples that lost no mass at all: not incubated, left out of
     /// `incubation_impacts` and counted against condition 2.
     pub samples_without_loss: usize,
-    /// First impact of the last-20 window (1-based); `null` when the series is shorter.
+    /// Each reported sample's first lossy impact (1-based; `null` for none), in sample order,
+    /// so the check can be made again from the file ([`reassess`]); empty in older files.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub first_loss_impacts: Vec<Option<usize>>,
+    /// First impact of the two compared slopes (1-based); `null` when the series is shorter.
     pub window_first_impact: Option<usize>,
     /// Reported samples whose first loss came at or before `window_first_impact`.
     pub samples_incubated_by_window: usize,
-    /// Slope of the mean series over its last 10 impacts; `null` below 20 impacts.
-    pub slope_last10: Option<SlopeFit>,
-    /// Slope of the mean series over the 10 impacts before those; `null` below 20 impacts.
-    pub slope_prev10: Option<SlopeFit>,
+    /// Impacts in each compared slope; files written before this field compared 10.
+    #[serde(default = "older_points")]
+    pub points: usize,
+    /// Slope of the mean series over its last `points` impacts; `null` below 2 × `points`.
+    #[serde(alias = "slope_last10")]
+    pub slope_last: Option<SlopeFit>,
+    /// Slope of the mean series over the `points` impacts before those.
+    #[serde(alias = "slope_prev10")]
+    pub slope_prev: Option<SlopeFit>,
+    /// Smallest relative change of rate the check would flag: [`STEADY_SIGMAS`] combined
+    /// standard errors over |last slope|; `null` where there are no slopes or the last is 0.
+    #[serde(default)]
+    pub detectable_change_rel: Option<f64>,
+}
+
+/// Impacts per compared slope in files written before `points` was recorded.
+fn older_points() -> usize {
+    10
 }
 
 /// Least-squares slope of y on x with its standard error for a cumulative series whose
@@ -110,8 +139,9 @@ pub fn slope_fit(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
     })
 }
 
-/// The two slopes of the steady-state check (last 10 and the 10 before) from a mean series
-/// (Fig. 10b); both `None` when it has fewer than 20 points.
+/// The two slopes of the steady-state check (last [`STEADY_POINTS`] and the
+/// [`STEADY_POINTS`] before) from a mean series (Fig. 10b); both `None` when it is shorter
+/// than both together.
 pub fn mean_series_slopes(mean: &[MeanPoint]) -> (Option<SlopeFit>, Option<SlopeFit>) {
     let n = mean.len();
     if n < 2 * STEADY_POINTS {
@@ -148,6 +178,75 @@ fn show(fit: SlopeFit) -> String {
 /// series (seed paper section 4, Figs. 8 and 10b); see the module documentation.
 pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
     let first: Vec<Option<usize>> = samples.iter().map(|s| first_loss_impact(s)).collect();
+    assess_first_losses(&first, mean)
+}
+
+/// The steady-state check made again from a results file's cell under this build's rule.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reassessed {
+    /// The check; for an older file whose incubation is unknown, made as if every sample had
+    /// incubated, so that only the slope conditions can fail.
+    pub state: SteadyState,
+    /// Whether the file told whether 80 % of the samples had lost mass by the window's start.
+    pub incubation_known: bool,
+}
+
+impl Reassessed {
+    /// `Some(steady)` when the file settles it, `None` when only the incubation is unknown.
+    pub fn steady(&self) -> Option<bool> {
+        (self.incubation_known || !self.state.steady).then_some(self.state.steady)
+    }
+}
+
+/// The steady-state check again from a results file's cell, under this build's rule: exact
+/// where the file stored each sample's first loss; older files keep only the range of first
+/// losses, which may not tell whether the samples had incubated by the start of this rule's
+/// longer window. `None` for a cell without a stored check.
+pub fn reassess(cell: &CellResult) -> Option<Reassessed> {
+    let old = cell.steady_state.as_ref()?;
+    let reported = cell.samples_reported;
+    if old.first_loss_impacts.len() == reported && reported > 0 {
+        return Some(Reassessed {
+            state: assess_first_losses(&old.first_loss_impacts, &cell.mean_series),
+            incubation_known: true,
+        });
+    }
+    let start = (cell.mean_series.len() + 1).saturating_sub(2 * STEADY_POINTS);
+    let lossy = reported - old.samples_without_loss.min(reported);
+    // Every lossy sample had lost by `max`; those that lost by the old (later) window start
+    // bound those that lost by the new one.
+    let (first, known): (Vec<Option<usize>>, bool) = match old.incubation_impacts {
+        Some(i) if i.max <= start => (
+            (0..reported)
+                .map(|k| (k < lossy).then_some(i.max))
+                .collect(),
+            true,
+        ),
+        _ if old.samples_incubated_by_window * 100 < STEADY_INCUBATED_PERCENT * reported => {
+            (vec![None; reported], true)
+        }
+        _ => (vec![Some(1); reported], false),
+    };
+    let mut state = assess_first_losses(&first, &cell.mean_series);
+    state.incubation_impacts = old.incubation_impacts;
+    state.samples_without_loss = old.samples_without_loss;
+    state.first_loss_impacts.clear();
+    if !known {
+        state.reason = format!(
+            "incubation by impact {start} not stored in this file (first losses {}–{}); {}",
+            old.incubation_impacts.map_or(0, |i| i.min),
+            old.incubation_impacts.map_or(0, |i| i.max),
+            state.reason
+        );
+    }
+    Some(Reassessed {
+        state,
+        incubation_known: known,
+    })
+}
+
+/// [`assess`] from each sample's first lossy impact (1-based, `None` for none).
+fn assess_first_losses(first: &[Option<usize>], mean: &[MeanPoint]) -> SteadyState {
     let lost: Vec<usize> = first.iter().flatten().copied().collect();
     let incubation_impacts = match (lost.iter().min(), lost.iter().max()) {
         (Some(&min), Some(&max)) => Some(Incubation {
@@ -157,17 +256,23 @@ pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
         }),
         _ => None,
     };
-    let samples_without_loss = samples.len() - lost.len();
+    let samples_without_loss = first.len() - lost.len();
     let n = mean.len();
     let window = 2 * STEADY_POINTS;
     let window_first_impact = (n >= window).then(|| n - window + 1);
     let samples_incubated_by_window =
         window_first_impact.map_or(0, |start| lost.iter().filter(|&&k| k <= start).count());
-    let (slope_last10, slope_prev10) = mean_series_slopes(mean);
+    let (slope_last, slope_prev) = mean_series_slopes(mean);
+    let detectable_change_rel = match (slope_last, slope_prev) {
+        (Some(l), Some(p)) if l.value != 0.0 => {
+            Some(STEADY_SIGMAS * l.sem.hypot(p.sem) / l.value.abs())
+        }
+        _ => None,
+    };
 
     let mut broken = Vec::new();
     let mut held = Vec::new();
-    if samples.is_empty() {
+    if first.is_empty() {
         broken.push("no samples reported".to_string());
     } else if n < window {
         broken.push(format!(
@@ -186,10 +291,10 @@ pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
         }
         let share = format!(
             "{samples_incubated_by_window} of {} samples lost mass by impact {start}, where \
-             the last-{window} window starts",
-            samples.len()
+             the two compared {STEADY_POINTS}-impact slopes start",
+            first.len()
         );
-        if samples_incubated_by_window * 100 >= STEADY_INCUBATED_PERCENT * samples.len() {
+        if samples_incubated_by_window * 100 >= STEADY_INCUBATED_PERCENT * first.len() {
             held.push(share);
         } else {
             broken.push(format!(
@@ -197,7 +302,7 @@ pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
             ));
         }
     }
-    match (slope_last10, slope_prev10) {
+    match (slope_last, slope_prev) {
         (Some(last), Some(prev)) => {
             let diff = (last.value - prev.value).abs();
             let combined = (last.sem * last.sem + prev.sem * prev.sem).sqrt();
@@ -211,8 +316,11 @@ pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
             } else {
                 "a difference with no scatter".to_string()
             };
+            let sees = detectable_change_rel.map_or(String::new(), |d| {
+                format!(" (the check sees changes of {:.0} % and more)", 100.0 * d)
+            });
             let text = format!(
-                "last-{STEADY_POINTS} slope {} against the previous {STEADY_POINTS}'s {}: {z}",
+                "last-{STEADY_POINTS} slope {} against the previous {STEADY_POINTS}'s {}: {z}{sees}",
                 show(last),
                 show(prev)
             );
@@ -234,9 +342,12 @@ pub fn assess(samples: &[Vec<SeriesPoint>], mean: &[MeanPoint]) -> SteadyState {
         reason: if steady { held } else { broken }.join("; "),
         incubation_impacts,
         samples_without_loss,
+        first_loss_impacts: first.to_vec(),
         window_first_impact,
         samples_incubated_by_window,
-        slope_last10,
-        slope_prev10,
+        points: STEADY_POINTS,
+        slope_last,
+        slope_prev,
+        detectable_change_rel,
     }
 }

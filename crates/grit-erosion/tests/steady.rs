@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use grit_erosion::aggregate::{aggregate_campaign, aggregate_cell, CellInput, SampleInput};
-use grit_erosion::steady::{slope_fit, STEADY_POINTS};
+use grit_erosion::steady::{reassess, slope_fit, Incubation, STEADY_POINTS};
 use grit_erosion::{CampaignResults, Impact, SLOPE_WINDOW};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -58,7 +58,7 @@ fn noisy_cell(rate: impl Fn(usize) -> f64) -> CellInput {
 
 #[test]
 fn a_cell_still_in_incubation_is_not_steady() {
-    // No loss until impacts 64..=68 of 70: the last-20 window (from impact 51) is incubation.
+    // No loss until impacts 64..=68 of 70: the compared 40 impacts (from 31) are incubation.
     let samples = (0..5u32)
         .map(|s| {
             let start = 63 + s as usize;
@@ -70,18 +70,18 @@ fn a_cell_still_in_incubation_is_not_steady() {
     assert!(!s.steady, "{}", s.reason);
     let inc = s.incubation_impacts.unwrap();
     assert_eq!((inc.min, inc.max, inc.mean), (64, 68, 66.0));
-    assert_eq!(s.window_first_impact, Some(51));
+    assert_eq!(s.window_first_impact, Some(31));
     assert_eq!(
         (s.samples_incubated_by_window, s.samples_without_loss),
         (0, 0)
     );
     assert!(
         s.reason
-            .contains("only 0 of 5 samples lost mass by impact 51"),
+            .contains("only 0 of 5 samples lost mass by impact 31"),
         "{}",
         s.reason
     );
-    assert_eq!(s.slope_prev10.unwrap().value, 0.0);
+    assert_eq!(s.slope_prev.unwrap().value, 0.0);
 }
 
 #[test]
@@ -92,7 +92,7 @@ fn a_linear_cell_with_scatter_after_early_incubation_is_steady() {
     let inc = s.incubation_impacts.unwrap();
     assert_eq!((inc.min, inc.max), (5, 9));
     assert_eq!(s.samples_incubated_by_window, 5);
-    let (last, prev) = (s.slope_last10.unwrap(), s.slope_prev10.unwrap());
+    let (last, prev) = (s.slope_last.unwrap(), s.slope_prev.unwrap());
     assert!(last.sem > 0.0 && prev.sem > 0.0);
     for f in [last, prev] {
         assert!((f.value - 2e-3).abs() < 3.0 * f.sem, "{f:?}");
@@ -105,9 +105,9 @@ fn a_linear_cell_with_scatter_after_early_incubation_is_steady() {
 }
 
 #[test]
-fn a_rate_that_doubles_in_the_last_ten_is_not_steady() {
+fn a_rate_that_doubles_in_the_last_twenty_is_not_steady() {
     let r = aggregate_cell(
-        &noisy_cell(|k| if k >= 60 { 4e-3 } else { 2e-3 }),
+        &noisy_cell(|k| if k >= 50 { 4e-3 } else { 2e-3 }),
         SLOPE_WINDOW,
     )
     .unwrap();
@@ -116,19 +116,19 @@ fn a_rate_that_doubles_in_the_last_ten_is_not_steady() {
     assert!(s.reason.contains("at most 2 allowed"), "{}", s.reason);
     // Incubation is long over: the slopes alone break the rule.
     assert_eq!(s.samples_incubated_by_window, 5);
-    assert!(s.slope_last10.unwrap().value > 1.5 * s.slope_prev10.unwrap().value);
+    assert!(s.slope_last.unwrap().value > 1.5 * s.slope_prev.unwrap().value);
 }
 
 #[test]
-fn a_cell_with_no_loss_in_its_last_ten_is_not_steady() {
-    let samples = vec![sample(0, 40, |k| if k < 25 { 2e-3 } else { 0.0 })];
-    let s = aggregate_cell(&cell(40, samples), SLOPE_WINDOW)
+fn a_cell_with_no_loss_in_its_last_twenty_is_not_steady() {
+    let samples = vec![sample(0, 60, |k| if k < 35 { 2e-3 } else { 0.0 })];
+    let s = aggregate_cell(&cell(60, samples), SLOPE_WINDOW)
         .unwrap()
         .steady_state
         .unwrap();
     assert!(!s.steady);
     assert!(
-        s.reason.contains("no mass lost in the last 10"),
+        s.reason.contains("no mass lost in the last 20"),
         "{}",
         s.reason
     );
@@ -136,10 +136,10 @@ fn a_cell_with_no_loss_in_its_last_ten_is_not_steady() {
 
 #[test]
 fn too_short_or_lossless_or_ragged_cells_say_why() {
-    let short = aggregate_cell(&cell(19, vec![sample(0, 19, |_| 1e-3)]), SLOPE_WINDOW).unwrap();
+    let short = aggregate_cell(&cell(39, vec![sample(0, 39, |_| 1e-3)]), SLOPE_WINDOW).unwrap();
     let s = short.steady_state.unwrap();
-    assert!(!s.steady && s.slope_last10.is_none() && s.window_first_impact.is_none());
-    assert!(s.reason.contains("only 19 impacts"), "{}", s.reason);
+    assert!(!s.steady && s.slope_last.is_none() && s.window_first_impact.is_none());
+    assert!(s.reason.contains("only 39 impacts"), "{}", s.reason);
 
     let lossless = aggregate_cell(&cell(30, vec![sample(0, 30, |_| 0.0)]), SLOPE_WINDOW).unwrap();
     let s = lossless.steady_state.unwrap();
@@ -172,7 +172,7 @@ fn eighty_percent_of_samples_must_be_past_incubation() {
             .steady_state
             .unwrap()
     };
-    // Four of five (80 %) incubated by impact 51 suffices, even when the fifth never loses.
+    // Four of five (80 %) incubated by impact 31 suffices, even when the fifth never loses.
     let s = with_late(70);
     assert_eq!(
         (s.samples_incubated_by_window, s.samples_without_loss),
@@ -191,12 +191,16 @@ fn eighty_percent_of_samples_must_be_past_incubation() {
     assert!(!s.steady);
     assert!(s.reason.starts_with("only 3 of 5 samples"), "{}", s.reason);
     // The late sample's start shows in the slopes unless it falls before the window.
-    let s = with_late(50);
+    let s = with_late(30);
     assert_eq!(
         s.samples_incubated_by_window, 5,
-        "first loss at 51 is at the window start"
+        "first loss at 31 is at the window start"
     );
     assert!(s.steady, "{}", s.reason);
+    // Later, its start raises the last slope by a quarter with no scatter to hide it.
+    let s = with_late(50);
+    assert_eq!(s.samples_incubated_by_window, 4);
+    assert!(!s.steady, "{}", s.reason);
 }
 
 #[test]
@@ -210,32 +214,30 @@ fn slope_and_standard_error_match_hand_values() {
     assert!(slope_fit(&[1.0, 2.0], &[0.0, 1.0]).is_none());
     assert!(slope_fit(&[1.0, 1.0, 1.0], &[0.0, 1.0, 2.0]).is_none());
 
-    // Through the cell: 20 impacts of one sample. Impacts 12..=20 (the increments inside
-    // the last-10 window) lose 1 grain-unit each except impact 16, which loses 3; the 10
-    // before lose 0.5 each. Over 10 equally spaced points wⱼ = (11 − j)(j − 1)/165 for
-    // j = 2..10, Σwⱼ = 1 and Σwⱼ² = 3333/27225; the jump sits at j = 6 (w = 25/165).
+    // Through the cell: 40 impacts of one sample. The last 20 lose 1 grain-unit each except
+    // impact 36, which loses 3; the 20 before lose 0.5 each. The cell's slopes are the
+    // hand-checked fit above over the mean series' two halves.
     let g = 1e-3;
-    let one = sample(0, 20, |k| match k {
-        15 => 3.0 * g,
-        10..=19 => g,
+    let one = sample(0, 40, |k| match k {
+        35 => 3.0 * g,
+        20..=39 => g,
         _ => 0.5 * g,
     });
-    let s = aggregate_cell(&cell(20, vec![one]), SLOPE_WINDOW)
-        .unwrap()
-        .steady_state
-        .unwrap();
-    let last = s.slope_last10.unwrap();
-    let b: f64 = 1.0 + 2.0 * 25.0 / 165.0;
-    let ssr = 8.0 * (1.0 - b) * (1.0 - b) + (3.0 - b) * (3.0 - b);
-    let se = (ssr / 8.0 * 3333.0 / 27225.0).sqrt();
-    assert!((last.value / g - b).abs() < 1e-9, "{last:?} vs {b}");
-    assert!((last.sem / g - se).abs() < 1e-9, "{last:?} vs {se}");
-    let prev = s.slope_prev10.unwrap();
+    let r = aggregate_cell(&cell(40, vec![one]), SLOPE_WINDOW).unwrap();
+    let s = r.steady_state.clone().unwrap();
+    let x: Vec<f64> = r.mean_series.iter().map(|p| p.grain_mass_kg).collect();
+    let y: Vec<f64> = r.mean_series.iter().map(|p| p.mass_loss_kg).collect();
+    assert_eq!(s.slope_last, slope_fit(&x[20..], &y[20..]));
+    let last = s.slope_last.unwrap();
+    assert!(last.value > g && last.sem > 0.0, "{last:?}");
+    let prev = s.slope_prev.unwrap();
     assert!(
         (prev.value / g - 0.5).abs() < 1e-9 && prev.sem / g < 1e-9,
         "{prev:?}"
     );
-    assert_eq!(STEADY_POINTS, 10);
+    let sees = s.detectable_change_rel.unwrap();
+    assert!((sees - 2.0 * last.sem.hypot(prev.sem) / last.value).abs() < 1e-12);
+    assert_eq!(STEADY_POINTS, 20);
 }
 
 #[test]
@@ -274,7 +276,7 @@ fn the_standard_error_matches_the_scatter_of_slopes() {
 fn campaign_carries_steadiness_spec_and_version() {
     let cells = [
         noisy_cell(|_| 2e-3),
-        noisy_cell(|k| if k >= 60 { 4e-3 } else { 2e-3 }),
+        noisy_cell(|k| if k >= 50 { 4e-3 } else { 2e-3 }),
     ];
     let r = aggregate_campaign(&cells, SLOPE_WINDOW)
         .unwrap()
@@ -283,7 +285,7 @@ fn campaign_carries_steadiness_spec_and_version() {
     assert_eq!(r.grit_version.as_deref(), Some(env!("CARGO_PKG_VERSION")));
     let warnings = r.unsteady_warnings();
     assert_eq!(warnings.len(), 1, "{warnings:?}");
-    assert!(warnings[0].starts_with("warning: cell 45° hexagon is not at steady state: last-10"));
+    assert!(warnings[0].starts_with("warning: cell 45° hexagon is not at steady state: last-20"));
     let json = serde_json::to_value(&r).unwrap();
     assert_eq!(json["spec"]["samples"], 5);
     assert_eq!(json["cells"][0]["steady_state"]["steady"], true);
@@ -314,4 +316,50 @@ fn older_results_files_still_load() {
             "{warnings:?}"
         );
     }
+}
+
+#[test]
+fn a_results_file_is_checked_again_under_the_current_rule() {
+    let r = aggregate_cell(&noisy_cell(|_| 2e-3), SLOPE_WINDOW).unwrap();
+    let again = reassess(&r).unwrap();
+    assert!(again.incubation_known);
+    assert_eq!(Some(&again.state), r.steady_state.as_ref());
+    assert_eq!(again.steady(), Some(true));
+
+    // A file written before the first losses were stored keeps only their range: 5–9 lies
+    // before the window's start (31), so the check is still complete.
+    let mut old = r.clone();
+    old.steady_state
+        .as_mut()
+        .unwrap()
+        .first_loss_impacts
+        .clear();
+    let again = reassess(&old).unwrap();
+    assert!(
+        again.incubation_known && again.state.steady,
+        "{}",
+        again.state.reason
+    );
+    // A last loss past the start leaves the incubation open; a failed slope still settles it.
+    old.steady_state.as_mut().unwrap().incubation_impacts = Some(Incubation {
+        min: 5,
+        mean: 20.0,
+        max: 45,
+    });
+    let again = reassess(&old).unwrap();
+    assert_eq!(again.steady(), None, "{}", again.state.reason);
+    let rising = aggregate_cell(
+        &noisy_cell(|k| if k >= 50 { 4e-3 } else { 2e-3 }),
+        SLOPE_WINDOW,
+    )
+    .unwrap();
+    let mut old = rising;
+    let st = old.steady_state.as_mut().unwrap();
+    st.first_loss_impacts.clear();
+    st.incubation_impacts = Some(Incubation {
+        min: 5,
+        mean: 20.0,
+        max: 45,
+    });
+    assert_eq!(reassess(&old).unwrap().steady(), Some(false));
 }
