@@ -1,7 +1,7 @@
 """Medians over the rounds of `grit bench impact --repeat 5 --json` files NAME-ROUND.json in a
 folder, one line per build name (standard library only).
 
-    python3 docs/performance/medians.py docs/performance/slim-2026-11-25 head slim
+    python3 notebook/performance/medians.py notebook/performance/slim-2026-11-25 head slim
 """
 import json
 import pathlib
