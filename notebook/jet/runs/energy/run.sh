@@ -1,7 +1,7 @@
 #!/bin/sh
 # The jet scene at 0.2 ms, seeds 1-3: copper on its cold curve (COLD: a build of e83395d)
 # against copper with its energy equation (NEW: this commit's build), side by side on one
-# thread each. Run from this folder; `python3 table.py` prints the docs/jet.md#energy table.
+# thread each. Run from this folder; `python3 table.py` prints the notebook/jet-log.md table of the energy equation (docs/jet.md#energy).
 # The *-verify.txt files are `grit verify --only jet --quick` of e83395d (cold) and of two
 # diagnostic builds that also gave the water an energy equation (not kept).
 COLD=${COLD:-grit-e83395d}
