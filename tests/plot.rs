@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use grit_erosion::fits::{ModifiedOkaModel, OkaModel, ShapeExponents, ShapeReference};
+use grit_erosion::models::oka::{ModifiedOkaModel, OkaModel, ShapeExponents, ShapeReference};
 use grit_erosion::{
     aggregate_campaign, CellInput, Impact, ImpactOutcome, ImpactRecord, SampleInput, Shape,
     SLOPE_WINDOW,

@@ -250,7 +250,7 @@ fn say_cells(results: &AnyResults) {
             }
         }
         AnyResults::Jet(r) => {
-            let pm = |s: &Option<grit_erosion::aggregate::Stats>, scale: f64| {
+            let pm = |s: &Option<grit_erosion::stats::Stats>, scale: f64| {
                 s.map_or("–".to_string(), |s| {
                     format!(
                         "{:.4} ± {}",

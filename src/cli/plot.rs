@@ -55,7 +55,7 @@ fn parse_window(s: &str) -> Result<(usize, usize), String> {
 }
 
 /// Prints the results beside Oka's g(α) and the seed's shape ratios, and any cell that several
-/// files have side by side (`grit_erosion::compare`).
+/// files have side by side (`grit_erosion::models::compare`).
 pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
     let inputs = a
         .results
@@ -68,8 +68,9 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
         Some((first, last)) => inputs
             .into_iter()
             .map(|(name, mut input)| {
-                let (r, notes) = grit_erosion::compare::on_window(&input.results, first, last)
-                    .map_err(|e| anyhow!("{name}: {e}"))?;
+                let (r, notes) =
+                    grit_erosion::models::compare::on_window(&input.results, first, last)
+                        .map_err(|e| anyhow!("{name}: {e}"))?;
                 if r.cells.is_empty() {
                     return Err(anyhow!(
                         "--window {first}-{last}: no cell of {name} has those impacts ({})",
@@ -91,15 +92,15 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|(n, i)| (n.clone(), &i.results))
         .collect();
-    let repeated = grit_erosion::compare::repeated_cells(&named);
+    let repeated = grit_erosion::models::compare::repeated_cells(&named);
     let (input, notes) = grit_plot::merge(inputs)?;
-    let mut c = grit_erosion::compare::compare(&input.results);
+    let mut c = grit_erosion::models::compare::compare(&input.results);
     c.repeated = repeated;
     let mut o = std::io::stdout().lock();
     if a.json {
         let _ = writeln!(o, "{}", serde_json::to_string_pretty(&c)?);
     } else {
-        let _ = write!(o, "{}", grit_erosion::compare::markdown(&c));
+        let _ = write!(o, "{}", grit_erosion::models::compare::markdown(&c));
         for n in window_notes.into_iter().chain(notes) {
             let _ = writeln!(o, "note: {n}");
         }

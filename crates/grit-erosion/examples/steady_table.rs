@@ -7,8 +7,9 @@
 //! by the start of the rule's window the cell says "cannot tell".
 use std::process::ExitCode;
 
-use grit_erosion::aggregate::CampaignResults;
-use grit_erosion::steady::{reassess, SlopeFit, SteadyState};
+use grit_erosion::impact::aggregate::CampaignResults;
+use grit_erosion::impact::steady::{reassess, SteadyState};
+use grit_erosion::stats::SlopeFit;
 
 /// The slopes' difference in combined standard errors, the quantity of condition 1.
 fn z(s: &SteadyState) -> String {

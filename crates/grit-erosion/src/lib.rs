@@ -4,28 +4,28 @@
 //! of the simulation's own choices (`studies`).
 #![warn(missing_docs)]
 
-pub mod aggregate;
 pub mod campaign;
-pub mod compare;
-pub mod fits;
-pub mod impact;
-pub mod jet;
-pub mod sample;
-pub mod shapes;
-pub mod steady;
+pub mod models;
+pub mod scene;
+pub mod scenes;
+pub mod stats;
 pub mod studies;
 
-pub use aggregate::{
-    aggregate_campaign, aggregate_cell, AggregateError, CampaignResults, CellInput, CellResult,
-    Impact, SampleInput, SLOPE_WINDOW,
+pub use scenes::{impact, jet};
+
+pub use impact::aggregate::{
+    aggregate_campaign, aggregate_cell, CampaignResults, CellInput, CellResult, Impact,
+    SampleInput, SLOPE_WINDOW,
 };
-pub use fits::{
-    fit_modified_oka, fit_oka, FitError, ModifiedOkaModel, OkaModel, ShapeExponents,
-    ShapeReference, AISI304_HV_GPA,
-};
+pub use impact::sample::{ImpactRecord, Sample, SampleError};
+pub use impact::steady::SteadyState;
 pub use impact::{
     filter_interval_in_time, ImpactError, ImpactOutcome, ImpactParams, Numerics, DEFAULT_CFL,
 };
-pub use sample::{ImpactRecord, Sample, SampleError};
-pub use shapes::{Shape, ShapeError, ShapeInfo};
-pub use steady::{SlopeFit, SteadyState};
+pub use models::oka::{
+    fit_modified_oka, fit_oka, FitError, ModifiedOkaModel, OkaModel, ShapeExponents,
+    ShapeReference, AISI304_HV_GPA,
+};
+pub use models::shapes::{Shape, ShapeError, ShapeInfo};
+pub use scene::{Scene, SceneError};
+pub use stats::{AggregateError, SlopeFit};

@@ -2,7 +2,7 @@
 //! then mass loss that grows, and a positive, finite erosion from the last 20 points.
 //! 16 particles per Dg and a 0.5 Dg aim range, so that erosion starts within 70 impacts.
 
-use grit_erosion::aggregate::{cumulative_series, sample_erosion};
+use grit_erosion::impact::aggregate::{cumulative_series, sample_erosion};
 use grit_erosion::{ImpactParams, Sample, Shape, SLOPE_WINDOW};
 
 #[test]

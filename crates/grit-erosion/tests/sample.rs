@@ -100,7 +100,10 @@ fn checkpoint_of_another_job_or_garbage_is_refused() {
     // A checkpoint written before the checksum (version 5, the same layout without it) reads.
     let body = &bytes[..bytes.len() - 32];
     let mut old = body.to_vec();
-    assert_eq!(old[0], grit_erosion::sample::CHECKPOINT_VERSION as u8);
+    assert_eq!(
+        old[0],
+        grit_erosion::impact::sample::CHECKPOINT_VERSION as u8
+    );
     old[0] = 5;
     let back = Sample::from_checkpoint(&old).unwrap();
     assert_eq!(back.seed(), 5);

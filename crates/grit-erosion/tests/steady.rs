@@ -2,8 +2,9 @@
 //! slopes and standard errors against hand-computed values, and older results files.
 use std::collections::BTreeMap;
 
-use grit_erosion::aggregate::{aggregate_campaign, aggregate_cell, CellInput, SampleInput};
-use grit_erosion::steady::{reassess, slope_fit, Incubation, STEADY_POINTS};
+use grit_erosion::impact::aggregate::{aggregate_campaign, aggregate_cell, CellInput, SampleInput};
+use grit_erosion::impact::steady::{reassess, Incubation, STEADY_POINTS};
+use grit_erosion::stats::slope_fit;
 use grit_erosion::{CampaignResults, Impact, SLOPE_WINDOW};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};

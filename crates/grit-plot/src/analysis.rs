@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::fits::{ErosionPoint, OkaFit, ShapedPoint};
+use grit_erosion::models::oka::{ErosionPoint, OkaFit, ShapedPoint};
 use grit_erosion::{
     fit_modified_oka, fit_oka, CampaignResults, ModifiedOkaModel, OkaModel, Shape, ShapeExponents,
     ShapeReference, AISI304_HV_GPA,

@@ -5,7 +5,7 @@
 
 use std::ops::Range;
 
-use grit_erosion::aggregate::cumulative_series;
+use grit_erosion::impact::aggregate::cumulative_series;
 use grit_erosion::{CampaignResults, CellResult, Impact};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;

@@ -538,7 +538,7 @@ pub fn plot_jet(results: &JetCampaignResults, out: &Path) -> Result<Report, Plot
 /// A short table of the jet cells: speed and other swept values, samples, Cd, Cw and mass
 /// loss at T (mean ± std) and the stage-3 slope.
 pub fn jet_summary_table(results: &JetCampaignResults) -> String {
-    let pm = |s: Option<grit_erosion::aggregate::Stats>, scale: f64| {
+    let pm = |s: Option<grit_erosion::stats::Stats>, scale: f64| {
         s.map_or("–".to_string(), |s| {
             format!(
                 "{:.2} ± {}",

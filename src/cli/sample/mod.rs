@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{bail, Context};
-use grit_erosion::aggregate::{cumulative_series, sample_erosion};
+use grit_erosion::impact::aggregate::{cumulative_series, sample_erosion};
 use grit_erosion::impact::PeakTracker;
 use grit_erosion::{ImpactParams, Sample, SLOPE_WINDOW};
 use serde::Serialize;

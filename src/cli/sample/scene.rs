@@ -71,7 +71,7 @@ impl SceneArgs {
             Some(path) => {
                 let text = std::fs::read_to_string(path)
                     .with_context(|| format!("reading {}", path.display()))?;
-                grit_erosion::impact::scene_from_json(&text, "ImpactParams")
+                grit_erosion::scene::scene_from_json(&text, "ImpactParams")
                     .with_context(|| format!("scene {}", path.display()))?
             }
             None => ImpactParams::default(),
@@ -85,7 +85,7 @@ impl SceneArgs {
             p.shape = Shape::from_name(name).with_context(|| {
                 format!(
                     "shape: unknown `{name}`; expected one of {}",
-                    grit_erosion::shapes::BUILTIN_NAMES.join(", ")
+                    grit_erosion::models::shapes::BUILTIN_NAMES.join(", ")
                 )
             })?;
         }

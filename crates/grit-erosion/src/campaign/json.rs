@@ -13,7 +13,8 @@ use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 use serde_path_to_error::Segment;
 
-use super::{err, same_angle, ImpactPlan, Impacts, MaterialSpec, SpecError, Sweep, UntilSteady};
+use super::{err, ImpactPlan, MaterialSpec, SpecError, Sweep, UntilSteady};
+use crate::impact::spec::{same_angle, Impacts};
 
 impl<'de, T: Deserialize<'de>> Deserialize<'de> for Sweep<T> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -23,7 +24,7 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for Sweep<T> {
 
 /// A single value or an array of values. Each kind of JSON value goes straight to `T`, never
 /// through a buffer, so an error inside keeps its path (`velocity_m_s[1]`) and serde's message.
-pub(super) fn one_or_many<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+pub(crate) fn one_or_many<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
     d: D,
 ) -> Result<Vec<T>, D::Error> {
     struct OneOrMany<T>(PhantomData<T>);
@@ -160,12 +161,12 @@ impl<'de> DeserializeSeed<'de> for AngleEntry<'_> {
     }
 }
 
-pub(super) fn not_a_count(v: impl fmt::Display) -> String {
+pub(crate) fn not_a_count(v: impl fmt::Display) -> String {
     format!("must be a whole number ≥ 0, got {v}")
 }
 
 /// A count (`samples`, impacts): a whole number that fits in u32.
-pub(super) fn count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+pub(crate) fn count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     let v = Value::deserialize(d)?;
     v.as_u64()
         .and_then(|n| u32::try_from(n).ok())
@@ -203,7 +204,7 @@ fn field_names<T: DeserializeOwned>() -> &'static [&'static str] {
 
 /// The JSON object of a spec's text; errors name `(json)` for text that is not JSON and
 /// `(campaign)` for JSON that is not an object.
-pub(super) fn spec_object(text: &str) -> Result<Map<String, Value>, SpecError> {
+pub(crate) fn spec_object(text: &str) -> Result<Map<String, Value>, SpecError> {
     match serde_json::from_str(text).map_err(|e| err("(json)", e.to_string()))? {
         Value::Object(map) => Ok(map),
         _ => Err(err("(campaign)", "must be a JSON object")),
@@ -212,7 +213,7 @@ pub(super) fn spec_object(text: &str) -> Result<Map<String, Value>, SpecError> {
 
 /// Every key of `map` that is not a field of `T`, named together with the known ones, so a
 /// user sees all their typos at once (serde stops at the first).
-pub(super) fn reject_unknown<T: DeserializeOwned>(
+pub(crate) fn reject_unknown<T: DeserializeOwned>(
     map: &Map<String, Value>,
     prefix: &str,
 ) -> Result<(), SpecError> {
@@ -237,7 +238,7 @@ pub(super) fn reject_unknown<T: DeserializeOwned>(
 
 /// The spec field a deserialisation error points at, written as users write it:
 /// `grain.diameter_m[1]`, and the angle keys of `impacts` quoted, `impacts["15"]`.
-pub(super) fn field_path(path: &serde_path_to_error::Path) -> String {
+pub(crate) fn field_path(path: &serde_path_to_error::Path) -> String {
     let mut out = String::new();
     for segment in path.iter() {
         match segment {

@@ -1,6 +1,6 @@
 //! How many impacts and samples a cell gets: a fixed count, or a rule the coordinator follows
 //! as results come in (`docs/erosion.md`, "Extending a cell"): impacts grown until the cell's
-//! steady-state check passes ([`crate::steady`]), samples added until the erosion's standard
+//! steady-state check passes ([`crate::impact::steady`]), samples added until the erosion's standard
 //! error over its mean is small enough.
 
 use std::fmt;
@@ -10,7 +10,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::json::count;
 use super::{err, SpecError, MAX_IMPACTS};
-use crate::aggregate::CellResult;
+use crate::impact::aggregate::CellResult;
 
 /// Grow every sample of a cell by `step` impacts until the cell is steady or reaches `max`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

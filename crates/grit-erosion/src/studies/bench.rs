@@ -8,7 +8,7 @@ use std::time::Instant;
 use grit_sph::World;
 use serde::{Deserialize, Serialize};
 
-use crate::sample::{Sample, SampleError};
+use crate::impact::sample::{Sample, SampleError};
 
 /// Figures of one timed impact, as `grit bench impact --json` prints them (names kept stable).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

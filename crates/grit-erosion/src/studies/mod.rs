@@ -11,9 +11,9 @@ pub mod sweep;
 
 pub use grit_sph::InputError;
 
+use crate::impact::sample::SampleError;
 use crate::impact::ImpactParams;
-use crate::sample::SampleError;
-use crate::shapes::Shape;
+use crate::models::shapes::Shape;
 
 /// Why a study could not run or stopped.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -4,8 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::impact::sample::{Sample, SampleError};
 use crate::impact::{run_impact, ImpactParams};
-use crate::sample::{Sample, SampleError};
 
 /// One impact run twice from the same surface and grain: with the scene's end criterion and
 /// with a stricter one.

@@ -10,8 +10,8 @@ use grit_sph::{ContactModel, InputError};
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
+use crate::impact::sample::{Sample, SampleError};
 use crate::impact::{run_impact_observed, ImpactError, ImpactParams, Numerics};
-use crate::sample::{Sample, SampleError};
 
 /// A run whose total energy rises above this multiple of its start gained energy from the
 /// numerics: it finished, but its numbers are not to be trusted.

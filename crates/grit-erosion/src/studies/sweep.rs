@@ -10,9 +10,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
-use crate::aggregate::{aggregate_cell, CellInput, SampleInput, SLOPE_WINDOW};
+use crate::impact::aggregate::{aggregate_cell, CellInput, SampleInput, SLOPE_WINDOW};
+use crate::impact::sample::{Sample, SampleError};
 use crate::impact::{filter_interval_in_time, ImpactParams, Numerics, MIN_SURFACE_LAYERS};
-use crate::sample::{Sample, SampleError};
 
 /// A numerical variant of the sweep: the numerics of Mohseni-Mofidi et al. 2022 (`seed`), or one
 /// choice changed.

@@ -2,15 +2,14 @@
 //! its parameters and seed, with a checkpoint after any impact that resumes bit for bit.
 
 use grit_sph::{Particles, Timers};
-use rand_chacha::ChaCha8Rng;
-use rand_core::{RngCore, SeedableRng};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::aggregate::Impact;
+use crate::impact::aggregate::Impact;
 use crate::impact::{
     run_impact_observed, GrainStart, ImpactError, ImpactOutcome, ImpactParams, StepObserver,
 };
+use crate::scene::stream_draws;
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
@@ -277,22 +276,6 @@ impl Sample {
             last_particles: 0,
         })
     }
-}
-
-/// Two uniform numbers in [0, 1) from ChaCha8 stream `k` of `seed`: draw k of a run does not
-/// depend on the draws before it, so a resumed run draws what an unbroken one would.
-pub(crate) fn stream_draws(seed: u64, k: u64) -> (f64, f64) {
-    let mut units = stream_units(seed, k);
-    let u = units.next().expect("the stream is endless");
-    (u, units.next().expect("the stream is endless"))
-}
-
-/// The uniform draws in [0, 1) of ChaCha8 stream `k` of `seed`, in order, without end (53 bits
-/// each); the first two are [`stream_draws`].
-pub(crate) fn stream_units(seed: u64, k: u64) -> impl Iterator<Item = f64> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(k);
-    std::iter::repeat_with(move || (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64))
 }
 
 #[cfg(test)]

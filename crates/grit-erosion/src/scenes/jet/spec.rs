@@ -17,8 +17,8 @@ use grit_sph::PenaltyParams;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use super::json::{self, count, field_path, reject_unknown};
-use super::{
+use crate::campaign::json::{self, count, field_path, reject_unknown};
+use crate::campaign::{
     check_cells, check_list_len, check_sweep, err, job_count, job_seed, MaterialSpec, SpecError,
     Sweep, MAX_JOBS,
 };

@@ -8,8 +8,8 @@
 //! With n points in a cell's mean series (slices 1..n), the window is the late half of the
 //! run: the last ⌊n/2⌋ points, slices n − ⌊n/2⌋ + 1 … n. The stage-3 slope is the least-squares
 //! slope of the mean mass loss against time over it, with the standard error of
-//! [`crate::steady::slope_fit`] (independent increments per slice). The cell is *steady* when
-//! all of these hold, in the spirit of the impact scene's check ([`crate::steady`]):
+//! [`crate::impact::steady::slope_fit`] (independent increments per slice). The cell is *steady* when
+//! all of these hold, in the spirit of the impact scene's check ([`crate::impact::steady`]):
 //!
 //! 1. the window has at least [`STAGE3_MIN_POINTS`] points (n ≥ 12), so each half has 3;
 //! 2. every point of the window averages the same number of samples (none still running);
@@ -26,9 +26,10 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::{JetParams, JetSlice, Layout};
-use crate::aggregate::{stats, AggregateError, Stats};
 use crate::campaign::Scene;
-use crate::steady::{slope_fit, Incubation, SlopeFit, STEADY_INCUBATED_PERCENT, STEADY_SIGMAS};
+use crate::impact::steady::{Incubation, STEADY_INCUBATED_PERCENT, STEADY_SIGMAS};
+use crate::stats::{slope_fit, SlopeFit};
+use crate::stats::{stats, AggregateError, Stats};
 
 /// Fewest points of the stage-3 window: two halves of three, the fewest a slope with a
 /// standard error needs.

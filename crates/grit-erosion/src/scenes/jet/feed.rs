@@ -7,7 +7,7 @@ use grit_sph::{InputError, Vector, World};
 use serde::{Deserialize, Serialize};
 
 use super::{JetParams, Layout};
-use crate::sample::stream_units;
+use crate::scene::stream_units;
 
 /// Length y_dis of the jet that carries one grain (m), eq. 55 solved for it: ρ_p v_jet V_a / M
 /// with V_a = π d³/6; infinite for M = 0.
@@ -125,7 +125,7 @@ impl Feed {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sample::stream_draws;
+    use crate::scene::stream_draws;
 
     /// The first `n` places of `params`' feed, each committed as `release` does.
     fn places(params: &JetParams, seed: u64, n: usize) -> Result<Vec<[f64; 2]>, InputError> {

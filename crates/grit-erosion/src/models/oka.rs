@@ -636,7 +636,7 @@ pub fn fit_modified_oka(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shapes::Shape;
+    use crate::models::shapes::Shape;
     use proptest::prelude::*;
 
     const ANGLES: [f64; 6] = [15.0, 30.0, 45.0, 60.0, 75.0, 90.0];

@@ -8,7 +8,7 @@ use serde::Deserialize;
 
 use super::aggregate::{JetCellInput, JetSampleInput};
 use super::{JetParams, JetSlice};
-use crate::aggregate::AggregateError;
+use crate::stats::AggregateError;
 
 /// One run as `grit jet --json` or `-o` writes it (the fields the aggregation needs).
 #[derive(Debug, Clone, Deserialize)]

@@ -10,181 +10,20 @@
 //! single value means no sweep. Cells are the Cartesian product, ordered with the angle
 //! varying fastest, then the shape, then velocity, grain diameter, grain density, spacing,
 //! distribution range and material (slowest).
-//!
-//! # Job seeds
-//! A job's seed is a pure function of (campaign seed, cell index, sample index):
-//!
-//! ```text
-//! job_seed = mix(mix(campaign_seed) XOR (cell << 32 | sample))
-//! mix(z):  z = (z XOR z >> 30) * 0xbf58476d1ce4e5b9
-//!          z = (z XOR z >> 27) * 0x94d049bb133111eb
-//!          z XOR z >> 31                           (wrapping u64 arithmetic)
-//! ```
-//!
-//! `mix` is the SplitMix64 finaliser, a bijection on u64, and so is XOR with a constant; so
-//! within one campaign distinct (cell, sample) pairs always get distinct seeds. The formula is
-//! fixed here (not std's `DefaultHasher`, whose output may change between Rust releases), so
-//! a campaign resubmitted years later replays the same grains.
 
 use std::collections::BTreeMap;
 
-use grit_sph::Material;
 use serde::{Deserialize, Serialize, Serializer};
 use serde_json::{Map, Value};
 
-use crate::aggregate::{CellInput, SampleInput};
-use crate::impact::ImpactParams;
-use crate::shapes::Shape;
-
-mod any;
-pub mod jet;
-mod json;
-mod plan;
-pub use any::AnySpec;
-pub use jet::{JetCampaignSpec, JetCell, JetJob, Scene};
-use json::{field_path, one_or_many, reject_unknown};
-pub use plan::{
-    annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
+use super::aggregate::{CellInput, SampleInput};
+use super::params::ImpactParams;
+use crate::campaign::json::{self, field_path, one_or_many, reject_unknown};
+use crate::campaign::{
+    check_cells, check_list_len, check_sweep, err, job_count, job_seed, ImpactPlan, MaterialSpec,
+    Samples, SpecError, Sweep, UntilSteady, MAX_IMPACTS, MAX_IMPACTS_TOTAL, MAX_JOBS, MIN_IMPACTS,
 };
-
-/// Fewest impacts a sample may be planned with: the slope window (20) plus one.
-pub const MIN_IMPACTS: u32 = 21;
-/// Most jobs one campaign may expand into; a guard against a typo that would flood the queue.
-pub const MAX_JOBS: usize = 1_000_000;
-/// Most impacts one sample may be planned with (fixed, or `until_steady.max`): about a week of
-/// one core at the seed's resolution, a guard against a typo that would hold a worker for years.
-pub const MAX_IMPACTS: u32 = 100_000;
-/// Most cells one campaign may have: each is a row with its scene in the database, checked at
-/// submission (the paper's campaign has 24).
-pub const MAX_CELLS: usize = 10_000;
-/// Most impacts one campaign may plan at its largest (every sample at its `max`): about six
-/// CPU-years at the seed's resolution, a guard against a typo that would fill the database.
-pub const MAX_IMPACTS_TOTAL: u128 = 100_000_000;
-
-/// The rule on the cell count: at most [`MAX_CELLS`], named on the longest list of `dims`.
-fn check_cells(dims: &[(&'static str, usize)]) -> Result<(), SpecError> {
-    let cells = job_count(dims.iter().map(|(_, len)| *len), 1);
-    if cells > MAX_CELLS as u128 {
-        let longest = dims.iter().max_by_key(|(_, len)| *len).map_or("", |d| d.0);
-        return Err(err(
-            longest,
-            format!("the lists multiply into {cells} cells, more than the limit of {MAX_CELLS}"),
-        ));
-    }
-    Ok(())
-}
-
-/// Most values one list of a spec may hold (angles, shapes, each swept field): the product of
-/// the lists is the cell count, which must stay countable and checkable at submission.
-pub const MAX_LIST: usize = 1_000;
-
-/// The rule every list of a spec keeps: at most [`MAX_LIST`] values.
-fn check_list_len(field: &str, len: usize) -> Result<(), SpecError> {
-    if len > MAX_LIST {
-        return Err(err(
-            field,
-            format!("lists {len} values, more than the limit of {MAX_LIST}"),
-        ));
-    }
-    Ok(())
-}
-
-/// The rules of one swept field: at least one value, each finite and > 0 (≥ 0 where not
-/// `positive`), none twice, at most [`MAX_LIST`]. A field of one value is named without index.
-fn check_sweep(name: &str, values: &[f64], positive: bool) -> Result<(), SpecError> {
-    if values.is_empty() {
-        return Err(err(name, "must give at least one value"));
-    }
-    check_list_len(name, values.len())?;
-    for (i, v) in values.iter().enumerate() {
-        let field = if values.len() > 1 {
-            format!("{name}[{i}]")
-        } else {
-            name.to_string()
-        };
-        if !v.is_finite() || *v < 0.0 || (positive && *v <= 0.0) {
-            let rule = if positive { "> 0" } else { "≥ 0" };
-            return Err(err(
-                field,
-                format!("must be a finite number {rule}, got {v}"),
-            ));
-        }
-        if values[..i].contains(v) {
-            return Err(err(field, format!("{v} listed twice")));
-        }
-    }
-    Ok(())
-}
-
-/// Jobs a campaign of these list lengths and samples per cell expands into, without overflow.
-fn job_count(lengths: impl IntoIterator<Item = usize>, samples: u32) -> u128 {
-    lengths
-        .into_iter()
-        .fold(samples as u128, |n, len| n.saturating_mul(len as u128))
-}
-
-/// A rejected campaign spec: `field` is the path of the offending value, `rule` what it broke.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{field}: {rule}")]
-pub struct SpecError {
-    /// Path of the field, e.g. `grain.diameter_m[1]` or `impacts["15"]`.
-    pub field: String,
-    /// The rule broken, in words.
-    pub rule: String,
-}
-
-fn err(field: impl Into<String>, rule: impl Into<String>) -> SpecError {
-    SpecError {
-        field: field.into(),
-        rule: rule.into(),
-    }
-}
-
-/// One value, or a list of values to sweep over: a JSON value or a JSON array of them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sweep<T>(pub Vec<T>);
-
-impl<T> Sweep<T> {
-    /// A sweep of one value (no sweep).
-    pub fn one(v: T) -> Self {
-        Sweep(vec![v])
-    }
-
-    /// The values in order.
-    pub fn values(&self) -> &[T] {
-        &self.0
-    }
-
-    /// Whether more than one value is given, so the value differs between cells.
-    pub fn is_swept(&self) -> bool {
-        self.0.len() > 1
-    }
-}
-
-impl<T: Serialize> Serialize for Sweep<T> {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        match self.0.as_slice() {
-            [one] => one.serialize(s),
-            many => many.serialize(s),
-        }
-    }
-}
-
-/// The surface material: a preset name (`grit_sph::MATERIAL_NAMES`) or a full
-/// `grit_sph::Material` object.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MaterialSpec(pub Material);
-
-impl Serialize for MaterialSpec {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        // A preset left unchanged is written by name, so stored specs stay short and readable.
-        if Material::by_name(&self.0.name).is_ok_and(|preset| preset == self.0) {
-            s.serialize_str(&self.0.name)
-        } else {
-            self.0.serialize(s)
-        }
-    }
-}
+use crate::models::shapes::Shape;
 
 /// Impacts per sample: one plan for every angle, or per angle with a `default`; each plan a
 /// number or `{"until_steady": {...}}` ([`ImpactPlan`]).
@@ -256,7 +95,7 @@ impl Serialize for Impacts {
 
 /// Angles from JSON keys ("15") and values (15.0) are compared to a tolerance far below any
 /// meaningful difference in impact angle.
-fn same_angle(a: f64, b: f64) -> bool {
+pub(crate) fn same_angle(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
 }
 
@@ -381,18 +220,6 @@ pub struct JobSpec {
     pub params: ImpactParams,
 }
 
-/// SplitMix64 finaliser: a bijection on u64 that scrambles every input bit into every output bit.
-fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The seed of sample `sample` of cell `cell` in a campaign seeded `campaign_seed` (module docs).
-pub fn job_seed(campaign_seed: u64, cell: u32, sample: u32) -> u64 {
-    mix(mix(campaign_seed) ^ ((cell as u64) << 32 | sample as u64))
-}
-
 /// Maps a field of `ImpactParams` to where the spec sets it, so scene errors name spec fields.
 fn spec_field(params_field: &str, sweeps: &[(&str, usize, bool)]) -> String {
     let (head, rest) = match params_field.split_once('.') {
@@ -462,7 +289,7 @@ impl CampaignSpec {
         }
         for (i, s) in self.shapes.iter().enumerate() {
             s.validate(&format!("shapes[{i}]")).map_err(|e| match e {
-                crate::shapes::ShapeError::Invalid { field, rule } => err(field, rule),
+                crate::models::shapes::ShapeError::Invalid { field, rule } => err(field, rule),
             })?;
             if self.shapes[..i].iter().any(|t| t.name() == s.name()) {
                 return Err(err(
@@ -707,6 +534,8 @@ impl Cell {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::campaign::{mix, MAX_LIST};
+    use grit_sph::Material;
 
     fn parse(json: &str) -> Result<CampaignSpec, SpecError> {
         CampaignSpec::from_json(json)

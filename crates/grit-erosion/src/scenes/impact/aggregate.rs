@@ -12,14 +12,15 @@
 //! Partial data (a campaign still running) aggregates the same way and is marked
 //! `partial: true`; every sum runs in sample-index order so results are reproducible.
 //!
-//! Each cell also carries a steady-state check of its mean series ([`crate::steady`]), and
+//! Each cell also carries a steady-state check of its mean series ([`crate::impact::steady`]), and
 //! the campaign says whether every cell passed it.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use crate::steady::{self, SteadyState};
+use super::steady::{self, SteadyState};
+use crate::stats::{invalid, least_squares_slope, stats, AggregateError};
 
 /// Number of final impacts whose slope is a sample's erosion (seed paper section 4).
 pub const SLOPE_WINDOW: usize = 20;
@@ -232,37 +233,6 @@ impl CampaignResults {
     }
 }
 
-/// Data that cannot be aggregated; names the field (`cells[1].samples[3].impacts[7]...`).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum AggregateError {
-    /// A field breaks a rule.
-    #[error("{field}: {rule}")]
-    Invalid {
-        /// Path of the offending field.
-        field: String,
-        /// The rule broken, in words.
-        rule: String,
-    },
-}
-
-impl AggregateError {
-    fn within(self, prefix: &str) -> Self {
-        match self {
-            AggregateError::Invalid { field, rule } => AggregateError::Invalid {
-                field: format!("{prefix}.{field}"),
-                rule,
-            },
-        }
-    }
-}
-
-fn invalid(field: String, rule: impl Into<String>) -> AggregateError {
-    AggregateError::Invalid {
-        field,
-        rule: rule.into(),
-    }
-}
-
 /// Cumulative mass loss against cumulative grain mass after each impact (Fig. 8).
 pub fn cumulative_series(impacts: &[Impact]) -> Vec<SeriesPoint> {
     let (mut grain, mut loss) = (0.0, 0.0);
@@ -279,46 +249,6 @@ pub fn cumulative_series(impacts: &[Impact]) -> Vec<SeriesPoint> {
         .collect()
 }
 
-/// Ordinary least-squares slope of y on x; `None` for fewer than 2 points or constant x.
-pub fn least_squares_slope(x: &[f64], y: &[f64]) -> Option<f64> {
-    assert_eq!(
-        x.len(),
-        y.len(),
-        "least_squares_slope: x and y differ in length"
-    );
-    let n = x.len();
-    if n < 2 {
-        return None;
-    }
-    let c = CentredSums::of(x, y);
-    (c.sxx > 0.0).then(|| c.sxy / c.sxx)
-}
-
-/// The sums of a least-squares line about the means: x̄, Σ(x − x̄)(y − ȳ) and Σ(x − x̄)².
-pub(crate) struct CentredSums {
-    pub xm: f64,
-    pub sxy: f64,
-    pub sxx: f64,
-}
-
-impl CentredSums {
-    /// Over the first min(len) points of x and y (at least one).
-    pub(crate) fn of(x: &[f64], y: &[f64]) -> CentredSums {
-        let n = x.len().min(y.len());
-        let (x, y) = (&x[..n], &y[..n]);
-        let xm = x.iter().sum::<f64>() / n as f64;
-        let ym = y.iter().sum::<f64>() / n as f64;
-        // Centred sums: cumulative masses are large offsets with small increments, and the
-        // uncentred formula would cancel catastrophically.
-        let (mut sxy, mut sxx) = (0.0, 0.0);
-        for (xi, yi) in x.iter().zip(y) {
-            sxy += (xi - xm) * (yi - ym);
-            sxx += (xi - xm) * (xi - xm);
-        }
-        CentredSums { xm, sxy, sxx }
-    }
-}
-
 /// A sample's erosion: slope of its series over the last `window` points (Fig. 8);
 /// `None` when the series is shorter than the window.
 pub fn sample_erosion(series: &[SeriesPoint], window: usize) -> Option<f64> {
@@ -329,35 +259,6 @@ pub fn sample_erosion(series: &[SeriesPoint], window: usize) -> Option<f64> {
     let x: Vec<f64> = tail.iter().map(|p| p.grain_mass_kg).collect();
     let y: Vec<f64> = tail.iter().map(|p| p.mass_loss_kg).collect();
     least_squares_slope(&x, &y)
-}
-
-/// Mean, sample standard deviation (n − 1) and standard error of the mean.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Stats {
-    /// Arithmetic mean.
-    pub mean: f64,
-    /// Sample standard deviation (n − 1); `None` below 2 values.
-    pub std: Option<f64>,
-    /// Standard error of the mean, std/√n; `None` below 2 values.
-    pub sem: Option<f64>,
-}
-
-/// Mean, sample std (n − 1) and standard error of `values`; `None` when empty.
-pub fn stats(values: &[f64]) -> Option<Stats> {
-    let n = values.len();
-    if n == 0 {
-        return None;
-    }
-    let mean = values.iter().sum::<f64>() / n as f64;
-    let std = (n >= 2).then(|| {
-        let ss: f64 = values.iter().map(|v| (v - mean) * (v - mean)).sum();
-        (ss / (n - 1) as f64).sqrt()
-    });
-    Some(Stats {
-        mean,
-        std,
-        sem: std.map(|s| s / (n as f64).sqrt()),
-    })
 }
 
 /// Running mean and std of the first k values for k = 1..n (Fig. 10a).

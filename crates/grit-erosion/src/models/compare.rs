@@ -8,11 +8,11 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use crate::aggregate::{CampaignResults, CellResult};
-use crate::fits::{
+use crate::impact::aggregate::{CampaignResults, CellResult};
+use crate::models::oka::{
     oka_g, oka_silica_exponents, shape_modification, ShapeExponents, ShapeReference, AISI304_HV_GPA,
 };
-use crate::shapes::Shape;
+use crate::models::shapes::Shape;
 
 /// The project's goal for normalised erosion: within ±15 % of Oka's g(α)/g(45°).
 pub const ANGLE_TOLERANCE: f64 = 0.15;
@@ -210,7 +210,7 @@ pub fn on_window(
         let part = &c.mean_series[first - 1..last];
         let x: Vec<f64> = part.iter().map(|p| p.grain_mass_kg).collect();
         let y: Vec<f64> = part.iter().map(|p| p.mass_loss_kg).collect();
-        let fit = crate::steady::slope_fit(&x, &y);
+        let fit = crate::stats::slope_fit(&x, &y);
         c.erosion_mean = fit.map(|f| f.value);
         c.erosion_sem = fit.map(|f| f.sem);
         c.erosion_std = None;
@@ -607,7 +607,7 @@ pub fn markdown(c: &Comparison) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::steady::SteadyState;
+    use crate::impact::steady::SteadyState;
 
     fn cell(shape: &str, angle: f64, mean: f64, sem: f64, steady: bool) -> CellResult {
         let json = serde_json::json!({
@@ -789,7 +789,7 @@ mod tests {
         // Hexagon: nothing until impact 10, then 2 per impact; square: 3 per impact throughout.
         let series = |loss: &dyn Fn(f64) -> f64, n: usize| {
             (1..=n)
-                .map(|k| crate::aggregate::MeanPoint {
+                .map(|k| crate::impact::aggregate::MeanPoint {
                     impact: k,
                     grain_mass_kg: k as f64,
                     mass_loss_kg: loss(k as f64),

@@ -29,7 +29,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::aggregate::{CellResult, CentredSums, MeanPoint, SeriesPoint, SLOPE_WINDOW};
+use super::aggregate::{CellResult, MeanPoint, SeriesPoint, SLOPE_WINDOW};
+use crate::stats::{slope_fit, SlopeFit};
 
 /// Impacts in each of the two slopes compared: the paper's last-20 window (section 4) and the
 /// 20 impacts before it.
@@ -43,15 +44,6 @@ pub const STEADY_SIGMAS: f64 = 2.0;
 /// the two compared slopes: one sample in five may still be incubating (see
 /// `docs/erosion.md`).
 pub const STEADY_INCUBATED_PERCENT: usize = 80;
-
-/// A least-squares slope with its standard error.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct SlopeFit {
-    /// Slope of cumulative mass loss against cumulative grain mass (dimensionless).
-    pub value: f64,
-    /// Standard error of the slope under independent per-impact losses.
-    pub sem: f64,
-}
 
 /// Impact number of the first mass loss, over the samples that lost any (1-based).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -103,40 +95,6 @@ pub struct SteadyState {
 /// Impacts per compared slope in files written before `points` was recorded.
 fn older_points() -> usize {
     10
-}
-
-/// Least-squares slope of y on x with its standard error for a cumulative series whose
-/// increments are independent: `None` below 3 points or for constant x.
-///
-/// With the increments `Δyⱼ = b·Δxⱼ + εⱼ`, εⱼ independent with variance σ², the slope is
-/// `b = Σⱼ wⱼ Δyⱼ` with `wⱼ = Σ_{k≥j} (x_k − x̄) / Sxx`, so `Var b = σ² Σⱼ wⱼ²`; σ² is
-/// estimated from the increments' residuals `Δyⱼ − b·Δxⱼ` with n − 2 degrees of freedom
-/// (n − 1 increments, one slope).
-pub fn slope_fit(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
-    let n = x.len().min(y.len());
-    if n < 3 {
-        return None;
-    }
-    let (x, y) = (&x[..n], &y[..n]);
-    let CentredSums { xm, sxy, sxx } = CentredSums::of(x, y);
-    if sxx <= 0.0 {
-        return None;
-    }
-    let b = sxy / sxx;
-    // Tail sums of centred x, from the last point back: w_j for j = n-1 down to 1.
-    let (mut tail, mut sum_w2, mut ssr) = (0.0, 0.0, 0.0);
-    for j in (1..n).rev() {
-        tail += x[j] - xm;
-        let w = tail / sxx;
-        sum_w2 += w * w;
-        let u = (y[j] - y[j - 1]) - b * (x[j] - x[j - 1]);
-        ssr += u * u;
-    }
-    let sigma2 = ssr / (n - 2) as f64;
-    Some(SlopeFit {
-        value: b,
-        sem: (sigma2 * sum_w2).sqrt(),
-    })
 }
 
 /// The two slopes of the steady-state check (last [`STEADY_POINTS`] and the

@@ -1,0 +1,13 @@
+//! The impact scene (seed paper section 4): one angular grain after another on a fresh
+//! AISI 304 surface; its parameters, one impact, a sample of impacts, the campaign spec, and
+//! the aggregation of mass-loss curves into steady-state erosion.
+
+pub mod aggregate;
+mod params;
+mod run;
+pub mod sample;
+pub mod spec;
+pub mod steady;
+
+pub use params::*;
+pub use run::*;
