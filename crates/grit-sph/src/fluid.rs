@@ -295,23 +295,34 @@ pub fn pressure_acceleration(
     -grad * (m_b * (p_a / (rho_bar_a * rho_bar_a) + p_b / (rho_bar_b * rho_bar_b)))
 }
 
-/// Particle a's laminar viscous acceleration (m/s²) in the form of Shao & Lo (2003), the AWJ
-/// paper eq. 25: 4 ν m_b (x_ab·∇_a W_ab) / [(ρ̄_a + ρ̄_b)(|x_ab|² + 0.01 h²)] v_ab; summed over
-/// the neighbours it approximates ν ∇²v.
-#[inline]
-#[allow(clippy::too_many_arguments)]
-pub fn shao_lo_acceleration(
-    nu: f64,
-    m_b: f64,
-    rho_bar_a: f64,
-    rho_bar_b: f64,
-    x_ab: Vector,
-    v_ab: Vector,
-    grad: Vector,
-    h: f64,
-) -> Vector {
-    let r2 = x_ab.norm_squared();
-    v_ab * (4.0 * nu * m_b * x_ab.dot(&grad) / ((rho_bar_a + rho_bar_b) * (r2 + 0.01 * h * h)))
+/// The laminar viscosity of Shao & Lo (2003), the AWJ paper eq. 25, for a fluid of kinematic
+/// viscosity ν with smoothing length h.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShaoLo {
+    /// Kinematic viscosity ν (m²/s).
+    pub nu: f64,
+    /// Smoothing length h (m): 0.01 h² keeps the pair term finite as |x_ab| → 0.
+    pub h: f64,
+}
+
+impl ShaoLo {
+    /// Particle a's laminar viscous acceleration (m/s²) from its pair with b:
+    /// 4 ν m_b (x_ab·∇_a W_ab) / [(ρ̄_a + ρ̄_b)(|x_ab|² + 0.01 h²)] v_ab; summed over the
+    /// neighbours it approximates ν ∇²v.
+    #[inline]
+    pub fn acceleration(
+        &self,
+        m_b: f64,
+        rho_bar_a: f64,
+        rho_bar_b: f64,
+        x_ab: Vector,
+        v_ab: Vector,
+        grad: Vector,
+    ) -> Vector {
+        let (nu, h) = (self.nu, self.h);
+        let r2 = x_ab.norm_squared();
+        v_ab * (4.0 * nu * m_b * x_ab.dot(&grad) / ((rho_bar_a + rho_bar_b) * (r2 + 0.01 * h * h)))
+    }
 }
 
 /// Particle a's artificial viscous acceleration −m_b Π_ab ∇_a W_ab (m/s²), the π^art term of the

@@ -3,6 +3,7 @@
 //! penalty contact (its eqs. 12–14); the paper is Sci. Rep. 14:26115 (2024), docs/jet.md#dem-abrasives.
 
 use crate::math::{perp, Vector};
+use crate::world::PenaltyParams;
 
 /// Damping ratio ξ = −ln e / √(π² + ln² e) that makes a linear spring–dashpot rebound with
 /// restitution coefficient `e` (docs/jet.md#dem-abrasives).
@@ -118,18 +119,17 @@ pub struct PenaltyContact {
 /// F^t = min(2 m_a/Δt |v_pa·t_p|, μ |F^n|) sign(v_pa·t_p) t_p, with v_pa = v_p − v_a the surface
 /// point's velocity relative to the particle (eq. 13 prints min() of a vector and a scalar; it is
 /// read as this magnitude cap with the direction of v_pa·t_p). `m_p` may be a mass per unit depth
-/// (the force is then per unit depth). `None` when apart.
-#[allow(clippy::too_many_arguments)]
+/// (the force is then per unit depth). χ and μ are `law`'s. `None` when apart.
 pub fn penalty_force(
     x_p: Vector,
     v_p: Vector,
     m_p: f64,
     grain: &super::Grain,
     d_ini: f64,
-    chi: f64,
-    friction: f64,
+    law: PenaltyParams,
     dt: f64,
 ) -> Option<PenaltyContact> {
+    let PenaltyParams { chi, friction } = law;
     let r = x_p - grain.pos;
     let dist = r.norm();
     let d_p = dist - grain.radius_m;
@@ -204,27 +204,44 @@ mod tests {
     fn penalty_pushes_the_particle_out_and_friction_opposes_sliding() {
         let g = super::super::Grain::sphere(Vector::zeros(), 1e-4, 4120.0);
         let (m_p, d_ini, dt) = (1e-6, 5e-5, 1e-8);
+        let law = |chi, friction| PenaltyParams { chi, friction };
         // Particle 20 µm off the surface along +y: inside the 50 µm range, overlap 30 µm.
         let x_p = Vector::new(0.0, 1.2e-4);
-        let c = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, 0.0, 0.3, dt).unwrap();
+        let c = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, law(0.0, 0.3), dt).unwrap();
         assert!((c.point - Vector::new(0.0, 1e-4)).norm() < 1e-18);
         let f = c.force_on_particle;
         let expect = 2.0 * m_p / (dt * dt) * 3e-5;
         assert!((f.y / expect - 1.0).abs() < 1e-12 && f.x == 0.0);
         // Half of it with χ = 0.5.
-        let h = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, 0.5, 0.3, dt)
+        let h = penalty_force(x_p, Vector::zeros(), m_p, &g, d_ini, law(0.5, 0.3), dt)
             .unwrap()
             .force_on_particle;
         assert!((h.y / (0.5 * expect) - 1.0).abs() < 1e-12);
         // Sliding fast along +x: friction along −x, capped at μ F^n.
-        let s = penalty_force(x_p, Vector::new(1e4, 0.0), m_p, &g, d_ini, 0.0, 0.3, dt)
-            .unwrap()
-            .force_on_particle;
+        let s = penalty_force(
+            x_p,
+            Vector::new(1e4, 0.0),
+            m_p,
+            &g,
+            d_ini,
+            law(0.0, 0.3),
+            dt,
+        )
+        .unwrap()
+        .force_on_particle;
         assert!((s.x / (-0.3 * expect) - 1.0).abs() < 1e-12, "{s:?}");
         // Slow sliding: the force that stops it in half a step, below the cap.
-        let s = penalty_force(x_p, Vector::new(1e-3, 0.0), m_p, &g, d_ini, 0.0, 0.3, dt)
-            .unwrap()
-            .force_on_particle;
+        let s = penalty_force(
+            x_p,
+            Vector::new(1e-3, 0.0),
+            m_p,
+            &g,
+            d_ini,
+            law(0.0, 0.3),
+            dt,
+        )
+        .unwrap()
+        .force_on_particle;
         assert!((s.x / (-2.0 * m_p / dt * 1e-3) - 1.0).abs() < 1e-12);
         // A spinning grain drags a resting particle along its surface: ω > 0 moves the top
         // point towards −x.
@@ -232,12 +249,12 @@ mod tests {
             omega: 1e5,
             ..g.clone()
         };
-        let d = penalty_force(x_p, Vector::zeros(), m_p, &spun, d_ini, 0.0, 0.3, dt)
+        let d = penalty_force(x_p, Vector::zeros(), m_p, &spun, d_ini, law(0.0, 0.3), dt)
             .unwrap()
             .force_on_particle;
         assert!(d.x < 0.0, "{d:?}");
         // Out of range.
         let far = Vector::new(0.0, 1.6e-4);
-        assert!(penalty_force(far, Vector::zeros(), m_p, &g, d_ini, 0.0, 0.3, dt).is_none());
+        assert!(penalty_force(far, Vector::zeros(), m_p, &g, d_ini, law(0.0, 0.3), dt).is_none());
     }
 }

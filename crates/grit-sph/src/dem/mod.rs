@@ -203,6 +203,16 @@ impl DemParams {
     }
 }
 
+/// Where two bodies touch in a step: along `n`, from the first body to the second, by `overlap`
+/// (m), the second's contact point moving at `v_rel` relative to the first's.
+#[derive(Debug, Clone, Copy)]
+struct Touch {
+    key: ContactKey,
+    n: Vector,
+    overlap: f64,
+    v_rel: Vector,
+}
+
 /// Which bodies a contact joins: two grains (lower index first) or a grain and a wall.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub enum ContactKey {
@@ -457,8 +467,13 @@ impl Dem {
                 - a.vel
                 - omega_cross(a.omega, n * a.radius_m);
             let (law, ra, rb) = (self.params.pair_law(a, b), a.radius_m, b.radius_m);
-            let key = ContactKey::Pair(i as u32, j as u32);
-            let fv = self.contact(&mut springs, key, law, n, overlap, v_rel, dt);
+            let touch = Touch {
+                key: ContactKey::Pair(i as u32, j as u32),
+                n,
+                overlap,
+                v_rel,
+            };
+            let fv = self.contact(&mut springs, touch, law, dt);
             self.force[i] -= fv;
             self.force[j] += fv;
             self.torque[i] += cross(n * ra, -fv);
@@ -475,8 +490,13 @@ impl Dem {
                 let n = -wall.normal;
                 let v_rel = -(g.vel + omega_cross(g.omega, n * g.radius_m));
                 let (law, r) = (self.params.wall_law(g), g.radius_m);
-                let key = ContactKey::Wall(i as u32, w as u32);
-                let fv = self.contact(&mut springs, key, law, n, overlap, v_rel, dt);
+                let touch = Touch {
+                    key: ContactKey::Wall(i as u32, w as u32),
+                    n,
+                    overlap,
+                    v_rel,
+                };
+                let fv = self.contact(&mut springs, touch, law, dt);
                 self.force[i] -= fv;
                 self.torque[i] += cross(n * r, -fv);
             }
@@ -485,20 +505,22 @@ impl Dem {
         self.reports.sort_by_key(|r| r.key);
     }
 
-    /// One contact along `n` (from the first body to the second): `law` with the tangential
-    /// spring carried over from the last step, kept in `springs` for the next, and its report.
-    /// Returns the force on the second body; the first takes its opposite.
-    #[allow(clippy::too_many_arguments)]
+    /// One contact, `touch`: `law` with the tangential spring carried over from the last step,
+    /// kept in `springs` for the next, and its report. Returns the force on the second body; the
+    /// first takes its opposite.
     fn contact(
         &mut self,
         springs: &mut BTreeMap<ContactKey, f64>,
-        key: ContactKey,
+        touch: Touch,
         law: SpringDashpot,
-        n: Vector,
-        overlap: f64,
-        v_rel: Vector,
         dt: f64,
     ) -> Vector {
+        let Touch {
+            key,
+            n,
+            overlap,
+            v_rel,
+        } = touch;
         let mut delta_t = self.springs.get(&key).copied().unwrap_or(0.0);
         let f = law.force(n, overlap, v_rel, &mut delta_t, dt);
         springs.insert(key, delta_t);

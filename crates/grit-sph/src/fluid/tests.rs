@@ -155,11 +155,12 @@ fn shao_lo_term_is_nu_laplacian() {
     let nu = w.kinematic_viscosity();
     let rho = w.density();
     let m = rho * DX * DX;
+    let law = ShaoLo { nu, h: k.h };
     let sum = |v: &dyn Fn(Vector) -> Vector| {
         let mut acc = Vector::zeros();
         for x_ab in lattice(&k) {
             let v_ab = v(Vector::zeros()) - v(-x_ab);
-            acc += shao_lo_acceleration(nu, m, rho, rho, x_ab, v_ab, grad_w(&k, x_ab), k.h);
+            acc += law.acceleration(m, rho, rho, x_ab, v_ab, grad_w(&k, x_ab));
         }
         acc
     };

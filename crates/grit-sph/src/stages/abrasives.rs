@@ -173,17 +173,9 @@ pub(crate) fn penalty(
         );
         near.sort_unstable();
         for &i in &near {
-            let pen = ab.penalty;
-            let Some(c) = penalty_force(
-                p.pos[i],
-                p.vel[i],
-                p.mass[i],
-                grain,
-                d_ini,
-                pen.chi,
-                pen.friction,
-                dt,
-            ) else {
+            let Some(c) =
+                penalty_force(p.pos[i], p.vel[i], p.mass[i], grain, d_ini, ab.penalty, dt)
+            else {
                 continue;
             };
             if touches.last().is_none_or(|&(t, _)| t != g) {

@@ -93,6 +93,12 @@ pub(crate) fn contact(
             c.params.damping_ratio,
             c.params.model,
         );
+        let probe = contact::Detector {
+            model,
+            kernel: k,
+            dx,
+            k_r,
+        };
         let prim_fixed = matches!(
             bodies[c.primary].rigid().map(|r| r.motion),
             Some(Motion::Fixed)
@@ -110,7 +116,7 @@ pub(crate) fn contact(
             .map(|(row, &i)| {
                 let i = i as usize;
                 let js = nl.of(row).iter().map(|&j| j as usize);
-                let det = contact::detect(model, k, dx, k_r, p.pos[i], js, &p.pos, |j| vol[j]);
+                let det = probe.detect(p.pos[i], js, &p.pos, |j| vol[j]);
                 let det = match det {
                     Some(d) if d.penetration > 0.0 => d,
                     _ => return Outcome::default(),
@@ -126,7 +132,13 @@ pub(crate) fn contact(
                     _ => p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]),
                 };
                 let c_t = 2.0 * zeta * (k_f * m_eff).sqrt();
-                let ff = contact::friction(&mut dl, vrel, det.normal, dt, k_f, c_t, mu, fr.norm());
+                let ff = contact::Friction { k_f, c_t, mu }.force(
+                    &mut dl,
+                    vrel,
+                    det.normal,
+                    dt,
+                    fr.norm(),
+                );
                 let cdamp = 2.0 * zeta * (k_r * m_eff).sqrt();
                 let fd = det.normal * (cdamp * pen_rate);
                 let work = -fd.norm() * pen_rate.abs() * dt;

@@ -175,6 +175,7 @@ pub(crate) fn fluid_accelerations(
         .for_each(|(i, (acc, th))| {
             let Some(f) = fc(i) else { return };
             let (rho_a, (p_a, c_a), v_a) = (p.rho[i], state[i], p.vel[i]);
+            let shao_lo = fluid::ShaoLo { nu: f.nu, h };
             // θ beside the total, each summed in the pairs' order: the total keeps the bits it
             // had before θ was split out.
             let (mut a, mut t) = (Vector::zeros(), Vector::zeros());
@@ -183,8 +184,7 @@ pub(crate) fn fluid_accelerations(
                 let grad = pair.xij * pair.dw_r;
                 let v_ab = v_a - p.vel[j];
                 let pressure = fluid::pressure_acceleration(m_b, p_a, rho_a, p_b, rho_b, grad);
-                let laminar =
-                    fluid::shao_lo_acceleration(f.nu, m_b, rho_a, rho_b, pair.xij, v_ab, grad, h);
+                let laminar = shao_lo.acceleration(m_b, rho_a, rho_b, pair.xij, v_ab, grad);
                 a += pressure;
                 a += laminar;
                 t += pressure + laminar;

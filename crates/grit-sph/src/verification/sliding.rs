@@ -2,7 +2,7 @@
 //! and pulled by Ft(t) = 0.8 Fn min(t / 1 s, 1), μ = 0.5. It sticks until Ft = μ Fn at 0.625 s,
 //! then accelerates ever faster until 1 s and at a constant rate after (docs/references.md#verification).
 
-use super::slope::{OVERLAP, TANGENTIAL_OVER_NORMAL};
+use super::slope::{spring_stiffness, TANGENTIAL_OVER_NORMAL};
 use super::{CaseReport, Chart, Row, Series};
 use crate::body::ExternalForce;
 use crate::body::Motion;
@@ -113,7 +113,7 @@ pub fn simulate(n_side: usize, sample_dt: f64) -> Result<(Vec<(f64, f64)>, f64),
         .expect("slider");
     // The long straight floor is the primary: the slider's particles then see its exact normal
     // everywhere, corners included. Springs as in the slope case (slope.rs says why).
-    let k = FN / (n_side as f64 * OVERLAP * dx);
+    let k = spring_stiffness(FN, n_side, dx);
     let ci = w
         .add_contact(
             floor_b,

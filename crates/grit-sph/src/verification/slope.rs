@@ -29,30 +29,30 @@ pub fn analytic_speed(mu: f64, t: f64) -> f64 {
     ((THETA.sin() - mu * THETA.cos()) * G * t).max(0.0)
 }
 
-/// Adds a fixed rigid `floor` and a free rigid `slider` resting on it, in contact with springs
-/// whose static overlap is OVERLAP·Δx when ~`n_side` of them carry `load_n_m` normal to the
-/// floor; returns (floor, slider, contact pair). Shared by the slope and controlled-sliding cases.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn slider_on_floor(
+/// The repulsion stiffness (N/m²) whose springs overlap by OVERLAP·Δx when ~`n_side` of them
+/// carry `load_n_m` (N/m). Shared by the slope and controlled-sliding cases.
+pub(super) fn spring_stiffness(load_n_m: f64, n_side: usize, dx: f64) -> f64 {
+    load_n_m / (n_side as f64 * OVERLAP * dx)
+}
+
+/// Adds a fixed rigid `floor` and a free rigid `slider` resting on it, in contact with
+/// repulsion springs of stiffness `k` ([`spring_stiffness`]); returns (floor, slider, contact
+/// pair).
+fn slider_on_floor(
     w: &mut World,
     floor: &Polygon,
     slider: &Polygon,
     rho: f64,
-    load_n_m: f64,
-    n_side: usize,
+    k: f64,
     model: ContactModel,
     mu: f64,
 ) -> (usize, usize, usize) {
-    let dx = w.settings().spacing_m;
     let floor_b = w
         .add_rigid("floor", floor, rho, Vector::zeros(), 0.0, Motion::Fixed)
         .expect("floor");
     let slider_b = w
         .add_rigid("slider", slider, rho, Vector::zeros(), 0.0, Motion::Free)
         .expect("slider");
-    // Stiffer springs make the slider chatter on its corners, softer ones let it lean onto its
-    // leading corner, where the smoothed normal tilts.
-    let k = load_n_m / (n_side as f64 * OVERLAP * dx);
     let params = ContactParams {
         model,
         friction: mu,
@@ -93,7 +93,10 @@ pub fn simulate(
     let slider = Polygon::rectangle(0.0, 0.0, SIDE, SIDE).rotated(-THETA, Vector::zeros());
     let rho = 1000.0;
     let load = rho * SIDE * SIDE * G * THETA.cos();
-    let (_, slider_b, ci) = slider_on_floor(&mut w, &slope, &slider, rho, load, n_side, model, mu);
+    // Stiffer springs make the slider chatter on its corners, softer ones let it lean onto its
+    // leading corner, where the smoothed normal tilts.
+    let k = spring_stiffness(load, n_side, dx);
+    let (_, slider_b, ci) = slider_on_floor(&mut w, &slope, &slider, rho, k, model, mu);
     // Settle first with friction that holds the slider (μ = 1 > tan θ), then lower μ at t0: the
     // slider starts at rest on loaded, tilted springs, as the seed's analytic solution assumes,
     // instead of falling onto unloaded ones and carrying the transient into the speed curve.

@@ -10,18 +10,43 @@ use crate::material::Material;
 use crate::math::{omega_cross, Matrix, Vector};
 use crate::particles::{Particles, BOUNDARY, KINEMATIC};
 
+/// A particle about to join a body: where, how fast, its mass per unit depth and density, its
+/// `BOUNDARY` / `KINEMATIC` bits, and its offset in a rigid body's frame.
+pub(super) struct NewParticle {
+    pub pos: Vector,
+    pub vel: Vector,
+    pub mass: f64,
+    pub rho: f64,
+    pub flags: u8,
+    pub local: Vector,
+}
+
+impl NewParticle {
+    /// A particle of a deformable or fluid body: no flags, no rigid-body offset.
+    pub fn free(pos: Vector, vel: Vector, mass: f64, rho: f64) -> NewParticle {
+        NewParticle {
+            pos,
+            vel,
+            mass,
+            rho,
+            flags: 0,
+            local: Vector::zeros(),
+        }
+    }
+}
+
 impl World {
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn push_particle(
-        &mut self,
-        body: usize,
-        x: Vector,
-        v: Vector,
-        mass: f64,
-        rho: f64,
-        flags: u8,
-        local: Vector,
-    ) {
+    /// Appends particle `np` to body `body` with a new id, unstressed, undamaged and at the
+    /// settings' temperature.
+    pub(super) fn push_particle(&mut self, body: usize, np: NewParticle) {
+        let NewParticle {
+            pos: x,
+            vel: v,
+            mass,
+            rho,
+            flags,
+            local,
+        } = np;
         let p = &mut self.particles;
         p.id.push(self.next_id);
         self.next_id += 1;
@@ -93,7 +118,7 @@ impl World {
             removed_particles: 0,
         });
         for (x, v) in points.iter().zip(volume_m2) {
-            self.push_particle(b, *x, velocity_m_s, rho * v, rho, 0, Vector::zeros());
+            self.push_particle(b, NewParticle::free(*x, velocity_m_s, rho * v, rho));
         }
         Ok(b)
     }
@@ -163,7 +188,7 @@ impl World {
             removed_particles: 0,
         });
         for ((x, v), r) in points.iter().zip(volume_m2).zip(rho) {
-            self.push_particle(b, *x, velocity_m_s, r * v, r, 0, Vector::zeros());
+            self.push_particle(b, NewParticle::free(*x, velocity_m_s, r * v, r));
             // ρ0 is the fluid's reference density, not the initial one.
             *self.particles.rho0.last_mut().expect("just pushed") = rho0;
         }
@@ -371,15 +396,15 @@ impl World {
             }
             let r = x - com;
             let v = velocity_m_s + omega_cross(omega_rad_s, r);
-            self.push_particle(
-                b,
-                *x,
-                v,
-                mp,
-                density_kg_m3,
-                if isb { BOUNDARY } else { 0 },
-                r,
-            );
+            let np = NewParticle {
+                pos: *x,
+                vel: v,
+                mass: mp,
+                rho: density_kg_m3,
+                flags: if isb { BOUNDARY } else { 0 },
+                local: r,
+            };
+            self.push_particle(b, np);
         }
         Ok(b)
     }

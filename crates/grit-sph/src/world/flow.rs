@@ -201,7 +201,7 @@ impl World {
         for j in 0..per {
             let off = (j as f64 + 0.5 - 0.5 * per as f64) * dx;
             let x = nz.centre_m + nz.direction * s + across * off;
-            self.push_particle(b, x, v, mass, rho0, 0, Vector::zeros());
+            self.push_particle(b, super::build::NewParticle::free(x, v, mass, rho0));
             // As in `add_fluid`: ρ0 is the fluid's reference density.
             *self.particles.rho0.last_mut().expect("just pushed") = rho0;
         }
