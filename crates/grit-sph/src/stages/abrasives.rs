@@ -7,7 +7,7 @@
 //! grains and a few hundred particles near them, and the sums stay independent of the thread
 //! count.
 
-use super::BodyConst;
+use super::StepCtx;
 use crate::coupling::{self, sphere_force, FluidView, Pair};
 use crate::dem::penalty_force;
 use crate::error::InputError;
@@ -109,19 +109,23 @@ pub(crate) fn evaluate_coupling(
     .map(Some)
 }
 
-/// The coupling forces of eqs. 42–50 ([`evaluate_coupling`]): F_af onto `loads` of each grain,
-/// and the reaction F_fa/m_a onto the acceleration `acc` of each fluid particle.
-#[allow(clippy::too_many_arguments)]
+/// The coupling forces of eqs. 42–50 ([`evaluate_coupling`]) with the fluid body of `ab`, if it
+/// has one: F_af onto `loads` of each grain, and the reaction F_fa/m_a onto the acceleration
+/// `acc` of each fluid particle.
 pub(crate) fn coupling_forces(
-    p: &Particles,
+    ctx: &StepCtx<'_>,
     ab: &Abrasives,
-    fluid_props: &crate::fluid::Fluid,
     frame: &CouplingFrame,
     porosity: &[f64],
     theta: &[Vector],
     acc: &mut [Vector],
     loads: &mut GrainLoads,
 ) -> Result<(), InputError> {
+    let Some(fb) = ab.fluid_body else {
+        return Ok(());
+    };
+    let p = &*ctx.p;
+    let fluid_props = ctx.bodies[fb].fluid().expect("checked by set_abrasives");
     let Some(f) = evaluate_coupling(p, ab, fluid_props, frame, porosity, theta)? else {
         return Ok(());
     };
@@ -135,19 +139,17 @@ pub(crate) fn coupling_forces(
 }
 
 /// The penalty contact (eqs. 12–14) between every grain and the deformable particles within
-/// `d_ini` of its surface: the force on each particle into `contact_force`, the reaction and
-/// its torque about the grain's centre into `loads`. `d_ini` is the particle spacing and `dt`
-/// the SPH step. Returns every grain that touches now, in grain order, with its approach speed
-/// along the normal of its first contact in particle order.
+/// d_ini of its surface: the force on each particle into `contact_force`, the reaction and its
+/// torque about the grain's centre into `loads`. d_ini is the particle spacing, and Δt the SPH
+/// step. Returns every grain that touches now, in grain order, with its approach speed along the
+/// normal of its first contact in particle order.
 pub(crate) fn penalty(
-    p: &Particles,
-    bc: &[BodyConst],
+    ctx: &StepCtx<'_>,
     ab: &Abrasives,
-    d_ini: f64,
-    dt: f64,
     contact_force: &mut [Vector],
     loads: &mut GrainLoads,
 ) -> Vec<(usize, f64)> {
+    let (p, bc, d_ini, dt) = (&*ctx.p, ctx.bc, ctx.settings.spacing_m, ctx.dt);
     let grains = &ab.dem.grains;
     let mut touches = Vec::new();
     if grains.is_empty() {

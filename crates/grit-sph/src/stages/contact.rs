@@ -3,8 +3,8 @@
 
 use rayon::prelude::*;
 
-use super::{ParTasks, SphView};
-use crate::body::{Body, Motion};
+use super::{ParTasks, StepCtx};
+use crate::body::Motion;
 use crate::contact::{self, ContactPair};
 use crate::math::{cross, Vector};
 use crate::neighbours::ContactLists;
@@ -42,27 +42,24 @@ pub(crate) struct PassedThrough {
     pub distance: f64,
 }
 
-/// Contact detection and forces for every pair (eqs. 21–29) with equilibrium distance `dx`:
-/// the force on each particle into `force`, the reactions into the rigid bodies' contact force
-/// and torque, the dashpot work added to `damping_work`. Reactions are collected per rigid body
-/// in particle order, so the sums do not depend on the thread count. Stops at the first pair
-/// in which a particle has passed through the primary surface, and returns it. `vol` holds the
-/// particle volumes, `lists[c]` pair c's candidate primary particles of the secondary particles
-/// near the primary. A secondary particle without candidates is out of contact: its spring and
+/// Contact detection and forces for every pair (eqs. 21–29), with the particle spacing as the
+/// equilibrium distance: the force on each particle into `force`, the reactions into the rigid
+/// bodies' contact force and torque, the dashpot work added to `damping_work`. Reactions are
+/// collected per rigid body in particle order, so the sums do not depend on the thread count.
+/// Stops at the first pair in which a particle has passed through the primary surface, and
+/// returns it. `vol` holds the particle volumes, `lists[c]` pair c's candidate primary particles
+/// of the secondary particles near the primary. A secondary particle without candidates is out of contact: its spring and
 /// penetration are zero (they are cleared once after each build, `ContactLists::sweep`).
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn contact(
-    s: SphView<'_>,
+    ctx: &mut StepCtx<'_>,
     lists: &mut [ContactLists],
     vol: &[f64],
-    dx: f64,
-    dt: f64,
     contacts: &mut [ContactPair],
-    bodies: &mut [Body],
     force: &mut Vec<Vector>,
     damping_work: &mut f64,
 ) -> Option<PassedThrough> {
-    let SphView { p, k, .. } = s;
+    let (p, k, dx, dt) = (&*ctx.p, ctx.kernel, ctx.settings.spacing_m, ctx.dt);
+    let bodies = &mut *ctx.bodies;
     let n = p.len();
     force.clear();
     force.resize(n, Vector::zeros());

@@ -6,10 +6,9 @@
 use rayon::prelude::*;
 
 use super::pairs::{pairs_of, PairCache};
-use super::{BodyConst, ParTasks, SphView, MIN_SUPPORT_NEIGHBOURS};
-use crate::fluid::{self, ArtificialViscosity};
+use super::{BodyConst, ParTasks, SphView, StepCtx, MIN_SUPPORT_NEIGHBOURS};
+use crate::fluid;
 use crate::math::{Matrix, Vector};
-use crate::neighbours::HalfIndex;
 use crate::particles::{Particles, KINEMATIC};
 
 /// Whether some body integrates an energy: only then do its same-body pairs need a pass of
@@ -21,20 +20,20 @@ pub(crate) fn any_solid_energy(bc: &[BodyConst]) -> bool {
 /// Adds to `heat` (J/kg/s, one per particle) the energy rate of each particle that carries an
 /// energy, from its same-body pairs at velocities `vel`: the stress power
 /// −Σ_j m_j v_ij·(σ_i/(ρ_i² Γ_i)) ∇_i W_ij, particle i's share of the work of the forces' stress
-/// term (seed eqs. 6, 9), and, with the solid's artificial viscosity `av`, the heat
-/// ½ m_j Π_ij v_ij·∇_i W_ij it dissipates. `sh` holds the Shepard sums Γ; summed in row order.
+/// term (seed eqs. 6, 9), and, with the solid's artificial viscosity
+/// (`Settings::solid_viscosity`), the heat ½ m_j Π_ij v_ij·∇_i W_ij it dissipates. `sh` holds the
+/// Shepard sums Γ; summed in row order.
 /// A particle carries an energy when its body's pressure law reads one, it moves by its forces
 /// (not kinematic: a target's fixed edge follows its prescribed motion) and it has a full
 /// support (the forces' own test); every other particle's rate stays 0.
 pub(crate) fn solid_energy_rates(
-    s: SphView<'_>,
-    hi: &HalfIndex,
+    ctx: &StepCtx<'_>,
     cache: &PairCache,
     sh: &[f64],
-    av: Option<ArtificialViscosity>,
     vel: &[Vector],
     heat: &mut [f64],
 ) {
+    let (s, hi, av) = (ctx.sph(), ctx.half, ctx.settings.solid_viscosity);
     let SphView { p, k, bc, .. } = s;
     let h = k.h;
     heat.par_iter_mut()

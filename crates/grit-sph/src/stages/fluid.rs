@@ -6,11 +6,10 @@
 use rayon::prelude::*;
 
 use super::pairs::{pairs_of, PairCache};
-use super::{BodyConst, ParTasks, SphView};
+use super::{BodyConst, ParTasks, SphView, StepCtx};
 use crate::eos::MieGruneisen;
 use crate::fluid::{self, ArtificialViscosity, Fluid};
 use crate::math::Vector;
-use crate::neighbours::HalfIndex;
 use crate::particles::{Particles, KINEMATIC};
 
 /// The porosity the fluid's EOS reads: 1, so the pressure is the EOS's at ρ̄ itself. The grains
@@ -88,14 +87,10 @@ impl FluidConst {
 }
 
 /// Continuity rates dρ̄/dt (eq. 22, plus the fluid's density diffusion where it has one) of
-/// every fluid particle, walls included, into `drho` (0 for the other particles), from the pairs `cache` holds for this step (`hi` names them); each
-/// particle gathers its pairs in its own row's order.
-pub(crate) fn fluid_continuity(
-    s: SphView<'_>,
-    hi: &HalfIndex,
-    cache: &PairCache,
-    drho: &mut Vec<f64>,
-) {
+/// every fluid particle, walls included, into `drho` (0 for the other particles), from the pairs
+/// `cache` holds for this step; each particle gathers its pairs in its own row's order.
+pub(crate) fn fluid_continuity(ctx: &StepCtx<'_>, cache: &PairCache, drho: &mut Vec<f64>) {
+    let (s, hi) = (ctx.sph(), ctx.half);
     let p = s.p;
     let h = s.k.h;
     drho.clear();
@@ -147,21 +142,20 @@ pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst]) -> Vec<(f64, f64)>
 
 /// Accelerations of the fluid particles into `accel`: pressure gradient (eq. 23) with the
 /// pressures of `state` ([`particle_state`]), Shao–Lo laminar viscosity (eq. 25), Monaghan
-/// artificial viscosity (eqs. 26–27) and gravity `g`; `theta` gets the pressure and laminar
-/// parts alone, θ_a of eq. 43, which the coupling interpolates at the grains (0 for other
+/// artificial viscosity (eqs. 26–27) and the settings' gravity; `theta` gets the pressure and
+/// laminar parts alone, θ_a of eq. 43, which the coupling interpolates at the grains (0 for other
 /// particles). Kinematic fluid particles (the walls) get the pair terms alone, which the
 /// integration ignores and [`wall_forces`] sums; the other bodies' particles keep what `accel`
 /// holds. Reads the densities after this step's continuity update, so density and velocity
 /// advance as a symplectic pair.
 pub(crate) fn fluid_accelerations(
-    s: SphView<'_>,
-    hi: &HalfIndex,
+    ctx: &StepCtx<'_>,
     cache: &PairCache,
     state: &[(f64, f64)],
-    g: Vector,
     accel: &mut [Vector],
     theta: &mut Vec<Vector>,
 ) {
+    let (s, hi, g) = (ctx.sph(), ctx.half, ctx.settings.gravity_m_s2);
     let SphView { p, k, bc, .. } = s;
     let h = k.h;
     let fc = |i: usize| bc[p.body[i] as usize].fluid;
@@ -215,12 +209,8 @@ pub struct WallLoad {
 /// The force m a of the pair accelerations of [`fluid_accelerations`] on every kinematic fluid
 /// particle (a fluid's walls), in particle order, so sums over them do not depend on the
 /// thread count.
-pub(crate) fn wall_forces(
-    p: &Particles,
-    bc: &[BodyConst],
-    accel: &[Vector],
-    loads: &mut Vec<WallLoad>,
-) {
+pub(crate) fn wall_forces(ctx: &StepCtx<'_>, accel: &[Vector], loads: &mut Vec<WallLoad>) {
+    let (p, bc) = (&*ctx.p, ctx.bc);
     loads.clear();
     for (i, a) in accel.iter().enumerate().take(p.len()) {
         let b = p.body[i] as usize;
@@ -234,10 +224,12 @@ pub(crate) fn wall_forces(
     }
 }
 
-/// Advances the density ρ̄ of every fluid particle by `dt` with the rates `drho` of
+/// Advances the density ρ̄ of every fluid particle by the step's `dt` with the rates `drho` of
 /// [`fluid_continuity`], before the accelerations read it (as the solid's stress stage
 /// advances ρ before its forces).
-pub(crate) fn fluid_density(p: &mut Particles, bc: &[BodyConst], drho: &[f64], dt: f64) {
+pub(crate) fn fluid_density(ctx: &mut StepCtx<'_>, drho: &[f64]) {
+    let (bc, dt) = (ctx.bc, ctx.dt);
+    let p = &mut *ctx.p;
     p.rho
         .par_iter_mut()
         .zip(p.body.par_iter())

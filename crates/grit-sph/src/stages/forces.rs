@@ -5,11 +5,9 @@
 use rayon::prelude::*;
 
 use super::pairs::{row_blocks, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
-use super::{ParTasks, SphView, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
+use super::{KernelSums, ParTasks, SphView, StepCtx, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{Matrix, Vector};
-use crate::neighbours::HalfIndex;
 use crate::particles::KINEMATIC;
-use crate::world::Settings;
 
 /// One particle's acceleration and the work of its hourglass force over the step.
 struct ParticleForce {
@@ -28,23 +26,22 @@ pub(crate) struct PairForce {
 }
 
 /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9, with the
-/// Shepard sums `sh`), the hourglass force (eq. 16, against the velocity gradients `gv`),
-/// Monaghan's Π_ij where `settings.solid_viscosity` asks for it, and gravity, into `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes
-/// after the stress stage. Each pair's shared terms are evaluated once (`hi`), and each particle
-/// gathers its pairs in its own row's order.
-#[allow(clippy::too_many_arguments)]
+/// Shepard sums of `sums`), the hourglass force (eq. 16, against the velocity gradients of
+/// `sums`), Monaghan's Π_ij where `Settings::solid_viscosity` asks for it, and gravity, into
+/// `accel`; returns the hourglass work of the step (J/m). `vol` holds the volumes after the
+/// stress stage (not the kernel sums' `sums.vol`: ρ has moved since). Each pair's shared terms
+/// are evaluated once (`StepCtx::half`) into `shared`, and each particle gathers its pairs in its
+/// own row's order.
 pub(crate) fn forces(
-    s: SphView<'_>,
-    hi: &HalfIndex,
+    ctx: &StepCtx<'_>,
     cache: &PairCache,
+    sums: &KernelSums,
     vol: &[f64],
-    sh: &[f64],
-    gv: &[Matrix],
-    settings: &Settings,
-    dt: f64,
     accel: &mut Vec<Vector>,
     shared: &mut Vec<PairForce>,
 ) -> f64 {
+    let (s, hi, settings, dt) = (ctx.sph(), ctx.half, ctx.settings, ctx.dt);
+    let (sh, gv) = (&sums.shepard, &sums.gradv);
     let SphView { p, nl, k, bc } = s;
     let alpha = settings.hourglass;
     let av = settings.solid_viscosity;

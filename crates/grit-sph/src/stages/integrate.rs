@@ -3,10 +3,10 @@
 
 use rayon::prelude::*;
 
-use super::{BodyConst, ParTasks};
-use crate::body::{Body, BodyKind};
+use super::{ParTasks, StepCtx};
+use crate::body::BodyKind;
 use crate::math::Vector;
-use crate::particles::{Particles, KINEMATIC};
+use crate::particles::KINEMATIC;
 
 /// What went wrong in a step that has blown up.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,20 +17,17 @@ pub(crate) enum Blowup {
     Rigid { body: usize },
 }
 
-/// Integrates deformable and fluid particles from `time` by `dt` (semi-implicit Euler) with the
-/// SPH accelerations `acc` and the contact forces `contact_force`. Then the failure checks:
-/// finite state, positive density, no particle moved more than `h`, finite rigid bodies.
-#[allow(clippy::too_many_arguments)]
+/// Integrates deformable and fluid particles over the step (semi-implicit Euler) with the SPH
+/// accelerations `acc` and the contact forces `contact_force`. Then the failure checks: finite
+/// state, positive density, no particle moved more than h, finite rigid bodies.
 pub(crate) fn integrate(
-    p: &mut Particles,
-    bodies: &[Body],
-    bc: &[BodyConst],
-    h: f64,
+    ctx: &mut StepCtx<'_>,
     acc: &[Vector],
     contact_force: &[Vector],
-    time: f64,
-    dt: f64,
 ) -> Option<Blowup> {
+    let (bc, h, time, dt) = (ctx.bc, ctx.kernel.h, ctx.time, ctx.dt);
+    let bodies = &*ctx.bodies;
+    let p = &mut *ctx.p;
     let t_next = time + dt;
     let motions: Vec<Option<Vector>> = bodies
         .iter()

@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::{BodyConst, ParTasks, SphView};
+use super::{BodyConst, ParTasks, SphView, StepCtx};
 use crate::fluid::{self, ArtificialViscosity};
 use crate::math::Vector;
 use crate::neighbours::NeighbourLists;
@@ -36,7 +36,8 @@ fn cross_pairs<'a>(
 
 /// Adds to the continuity rates `drho` of the fluid particles (eq. 22) the terms of their solid
 /// neighbours: ρ̄_a (m_b/ρ_b) v_ab·∇_a W_ab, so the target bounds the water as a moving wall.
-pub(crate) fn interface_continuity(s: SphView<'_>, cross: &NeighbourLists, drho: &mut [f64]) {
+pub(crate) fn interface_continuity(ctx: &StepCtx<'_>, drho: &mut [f64]) {
+    let (s, cross) = (ctx.sph(), ctx.cross);
     let p = s.p;
     drho.par_iter_mut()
         .par_tasks()
@@ -73,18 +74,18 @@ fn pair_viscosity(
 /// `theta` of the fluid side (θ_a of eq. 43 then holds the whole pressure gradient a fluid
 /// particle feels). Per pair (a fluid, b solid, ρ̄ the fluid's porosity-weighted density, ρ the
 /// solid's), on a: −(m_b/(ρ̄_a ρ_b))(P_a + P_b)∇_a W_ab − m_b Π_ab ∇_a W_ab, and b gets the same
-/// with a and b swapped, so the pair's forces cancel. `state` holds each particle's pressure and
+/// with a and b swapped, so the pair's forces cancel; Π_ab with the mean of the fluid's and the
+/// solid's viscosity (`Settings::solid_viscosity`). `state` holds each particle's pressure and
 /// sound speed (`particle_state`); the solid's pressure is cut at the fluid's lowest, since the
 /// water cannot pull harder on the surface than it can hold together. Each particle gathers in
 /// its own row's order.
 pub(crate) fn interface_forces(
-    s: SphView<'_>,
-    cross: &NeighbourLists,
+    ctx: &StepCtx<'_>,
     state: &[(f64, f64)],
-    solid_viscosity: Option<ArtificialViscosity>,
     accel: &mut [Vector],
     theta: &mut [Vector],
 ) {
+    let (s, cross, solid_viscosity) = (ctx.sph(), ctx.cross, ctx.settings.solid_viscosity);
     let SphView { p, k, bc, .. } = s;
     let h = k.h;
     accel

@@ -7,9 +7,8 @@
 use rayon::prelude::*;
 
 use super::pairs::{fill_half_pairs, row_blocks, PairCache, Side, APART, ROWS_PER_BLOCK, USED};
-use super::{SphView, MIN_SUPPORT_NEIGHBOURS};
+use super::{SphView, StepCtx, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{outer, Matrix};
-use crate::neighbours::HalfIndex;
 
 /// Per-particle results of the kernel sums, read by the later stages of the same step.
 #[derive(Debug, Clone, Default)]
@@ -36,16 +35,12 @@ struct ParticleSums {
 
 /// Shepard sums Γ_i = Σ V_j W_ij (eq. 9 denominator), Bonet–Lok matrices L_i (eq. 8) and
 /// velocity gradients (eqs. 15 and 7) into `sums`; every same-body pair inside the support into
-/// `cache`, evaluated once per pair (`hi`). The velocity gradient of particle i needs only its
-/// own L_i, so it is summed in the same pass, term by term in the same order as a separate pass
-/// would.
-pub(crate) fn kernel_sums(
-    s: SphView<'_>,
-    hi: &HalfIndex,
-    cache: &mut PairCache,
-    sums: &mut KernelSums,
-) {
-    let SphView { p, nl, k, bc } = s;
+/// `cache`, evaluated once per pair (`StepCtx::half`). The velocity gradient of particle i needs
+/// only its own L_i, so it is summed in the same pass, term by term in the same order as a
+/// separate pass would.
+pub(crate) fn kernel_sums(ctx: &StepCtx<'_>, cache: &mut PairCache, sums: &mut KernelSums) {
+    let SphView { p, nl, k, bc } = ctx.sph();
+    let hi = ctx.half;
     let w0 = k.w(0.0);
     super::volumes(p, &mut sums.vol);
     let vol = &sums.vol;

@@ -1,6 +1,6 @@
 //! The stages of one explicit step (docs/design.md "Engine step"; seed sections 2 and 3), as free
-//! functions: each borrows what it reads, writes into the outputs it is given and returns the
-//! rest. `World::step` is the one place that runs them, in order.
+//! functions: each reads the step's [`StepCtx`], writes into the outputs it is given and returns
+//! the rest. `World::step` is the one place that runs them, in order.
 
 mod abrasives;
 mod ceiling;
@@ -47,8 +47,9 @@ use crate::body::Body;
 use crate::eos::EquationOfState;
 use crate::kernel::Kernel;
 use crate::material::Material;
-use crate::neighbours::NeighbourLists;
+use crate::neighbours::{HalfIndex, NeighbourLists};
 use crate::particles::Particles;
+use crate::world::Settings;
 
 /// A deformable particle with fewer same-body neighbours inside the kernel support than this is
 /// a fragment torn off its body: its kernel sums no longer describe a continuum (the Shepard
@@ -232,4 +233,43 @@ pub(crate) struct SphView<'a> {
     pub nl: &'a NeighbourLists,
     pub k: &'a Kernel,
     pub bc: &'a [BodyConst],
+}
+
+/// What the stages of one step share (docs/design.md "Engine step"): the particles and bodies
+/// they advance, the constants and neighbour lists they read, the clock and the time step.
+/// `World::step` builds one per step; each stage takes it beside the outputs of its own, so a
+/// stage's signature says what it writes.
+pub(crate) struct StepCtx<'a> {
+    /// The particles: the stress, fluid density, rigid and integration stages write them.
+    pub p: &'a mut Particles,
+    /// The bodies: the contact stage writes the rigid bodies' loads, the rigid stage their motion.
+    pub bodies: &'a mut [Body],
+    /// The bodies' constants, by body index.
+    pub bc: &'a [BodyConst],
+    /// The world's settings.
+    pub settings: &'a Settings,
+    /// The kernel W and its smoothing length h.
+    pub kernel: &'a Kernel,
+    /// Same-body neighbours, built before the step's first stage.
+    pub same: &'a NeighbourLists,
+    /// The unordered pair of each entry of `same`.
+    pub half: &'a HalfIndex,
+    /// Fluid–solid pairs (`WorldLists::cross`).
+    pub cross: &'a NeighbourLists,
+    /// Simulated time at the step's start (s).
+    pub time: f64,
+    /// The step's time step (s).
+    pub dt: f64,
+}
+
+impl StepCtx<'_> {
+    /// What the SPH sums read, over the particles as they are now.
+    pub fn sph(&self) -> SphView<'_> {
+        SphView {
+            p: self.p,
+            nl: self.same,
+            k: self.kernel,
+            bc: self.bc,
+        }
+    }
 }

@@ -2,15 +2,17 @@
 
 use rayon::prelude::*;
 
-use super::ParTasks;
-use crate::body::{Body, Motion};
-use crate::math::{omega_cross, rotate, Vector};
-use crate::particles::Particles;
+use super::{ParTasks, StepCtx};
+use crate::body::Motion;
+use crate::math::{omega_cross, rotate};
 
-/// Advances every rigid body from `time` by `dt` from its contact force and torque, external
-/// force and gravity `g` (eq. 17, semi-implicit Euler), or along its prescribed motion, and
-/// moves its particles with it.
-pub(crate) fn rigid(bodies: &mut [Body], p: &mut Particles, g: Vector, time: f64, dt: f64) {
+/// Advances every rigid body over the step from its contact force and torque, external force
+/// and gravity (eq. 17, semi-implicit Euler), or along its prescribed motion, and moves its
+/// particles with it.
+pub(crate) fn rigid(ctx: &mut StepCtx<'_>) {
+    let (g, time, dt) = (ctx.settings.gravity_m_s2, ctx.time, ctx.dt);
+    let bodies = &mut *ctx.bodies;
+    let p = &mut *ctx.p;
     let t_next = time + dt;
     for b in bodies.iter_mut() {
         let Some(r) = b.rigid_mut() else { continue };

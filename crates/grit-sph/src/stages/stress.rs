@@ -3,11 +3,10 @@
 
 use rayon::prelude::*;
 
-use super::{BodyConst, ParTasks};
-use crate::body::Body;
+use super::{ParTasks, StepCtx};
 use crate::material::{Fracture, JohnsonCook, Strength};
 use crate::math::Matrix;
-use crate::particles::{von_mises, Particles};
+use crate::particles::von_mises;
 use crate::physics::{self, YieldAt};
 
 /// A particle's zero-rate yield stress (`physics::YieldAt`) as last computed, with the particle
@@ -53,20 +52,14 @@ impl YieldMemo {
 }
 
 /// Continuity (eq. 5 as ρ̇ = −ρ tr ∇v), Jaumann rate (eq. 13), radial return with Johnson–Cook
-/// yield (eq. 18), adiabatic heating with Taylor–Quinney coefficient `beta`, damage
+/// yield (eq. 18), adiabatic heating with the Taylor–Quinney coefficient of the settings, damage
 /// (eqs. 19–20), and the deformation gradient the hourglass stiffness compares against, from the
 /// velocity gradients `gv`; returns the plastic work of the step (J/m). `memo` keeps each
 /// particle's zero-rate yield stress between steps.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn stress(
-    p: &mut Particles,
-    bodies: &[Body],
-    bc: &[BodyConst],
-    gv: &[Matrix],
-    beta: f64,
-    dt: f64,
-    memo: &mut Vec<YieldMemo>,
-) -> f64 {
+pub(crate) fn stress(ctx: &mut StepCtx<'_>, gv: &[Matrix], memo: &mut Vec<YieldMemo>) -> f64 {
+    let (bc, beta, dt) = (ctx.bc, ctx.settings.taylor_quinney, ctx.dt);
+    let bodies = &*ctx.bodies;
+    let p = &mut *ctx.p;
     memo.resize(p.len(), YieldMemo::default());
     let plastic_work: f64 = p
         .rho

@@ -1,15 +1,16 @@
 //! The world: bodies, particles and contacts, and the explicit step that advances them
 //! (docs/design.md "Engine step"; seed section 2 for the solid, section 3 for contact).
 //!
-//! `step` lists the stages in order; each stage is a free function in `crate::stages` that this
-//! module hands the world's arrays. Building a world is in `build`, its settings in `settings`,
-//! what it reports about itself in `diagnostics`.
+//! `step` lists the stages in order; each stage is a free function in `crate::stages`, which
+//! `step::Step` hands the step's context and the arrays the stage writes. Building a world is in
+//! `build`, its settings in `settings`, what it reports about itself in `diagnostics`.
 
 mod abrasives;
 mod build;
 mod diagnostics;
 mod flow;
 mod settings;
+mod step;
 
 pub use crate::stages::{CeilingPass, WallLoad, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
 pub use abrasives::{plane_mass, Abrasives, GrainContacts, GrainHit, GrainOutflow, PenaltyParams};
@@ -27,50 +28,9 @@ use crate::kernel::Kernel;
 use crate::math::Vector;
 use crate::neighbours::{self, WorldLists};
 use crate::particles::Particles;
-use crate::stages::{
-    self, Blowup, BodyConst, KernelSums, PairCache, PairForce, ParTasks, PassedThrough, SphView,
-};
+use crate::stages::{self, BodyConst, ParTasks};
 use crate::timers::{Stage, Timers};
-
-/// Scratch arrays rebuilt every step (not part of a checkpoint).
-#[derive(Debug, Clone, Default)]
-struct Scratch {
-    /// Same-body pairs of this step with their kernel values (the kernel sums fill it).
-    pairs: PairCache,
-    /// The force terms each same-body pair's particles share (the forces fill it).
-    pair_forces: Vec<PairForce>,
-    /// Volumes, Shepard sums, correction matrices and velocity gradients of the kernel sums.
-    sums: KernelSums,
-    /// Particle volumes after the stress stage: read by the forces, the contact and the density
-    /// filter, which all run before ρ changes again.
-    vol: Vec<f64>,
-    /// Each particle's zero-rate yield stress, kept while its ε_p and T stay (the stress stage).
-    yield_memo: Vec<stages::YieldMemo>,
-    /// Accelerations of the forces.
-    acc: Vec<Vector>,
-    /// Contact force on each particle.
-    contact_force: Vec<Vector>,
-    /// Continuity rates dρ̄/dt of the fluid particles (the fluid stage fills it).
-    drho: Vec<f64>,
-    /// The force the fluids' pair terms put on each of their kinematic particles.
-    wall_loads: Vec<WallLoad>,
-    /// Porosity ε of every particle (eq. 20; 1 away from grains), for the coupling's averages
-    /// and drag (the fluid's EOS reads ρ̄ alone: docs/jet.md#porosity-and-the-eos).
-    porosity: Vec<f64>,
-    /// Pressure and sound speed of every particle this step (`stages::particle_state`).
-    state: Vec<(f64, f64)>,
-    /// θ_a of the AWJ paper eq. 43 per particle: the fluid's pressure and laminar acceleration.
-    theta: Vec<Vector>,
-    /// Energy rates per particle this step (J/kg/s): the solids' stress power and heating.
-    heat: Vec<f64>,
-    /// Velocities at the start of the integration, then the step's mean velocities, for the
-    /// solids' energy at mid-step.
-    vel_start: Vec<Vector>,
-    /// The grains' pairs with the fluid at the step's start.
-    frame: stages::CouplingFrame,
-    /// Loads on the grains from the fluid and the target.
-    loads: stages::GrainLoads,
-}
+use step::Scratch;
 
 /// A 2D SPH scene: bodies, their particles, contact pairs, time.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -306,35 +266,46 @@ impl World {
         let bc = self.kept_body_consts();
 
         let mut timers = std::mem::take(&mut self.timers);
+        let t = &mut timers;
         if self.needs_rebuild() {
-            timers.time(Stage::Neighbours, || self.rebuild_neighbours());
+            t.time(Stage::Neighbours, || self.rebuild_neighbours());
         }
+        let mut s = self.begin_step(&bc);
         // The rates are summed in the kernel sums' pass; their timer stays at zero in a step.
-        timers.time(Stage::KernelSums, || self.kernel_sums(&bc));
-        if let Some(ab) = &self.abrasives {
-            let sc = &mut self.scratch;
-            // A grain set that `set_abrasives` accepted always gives pairs.
-            sc.frame = stages::grain_porosity(&self.particles, ab, &mut sc.porosity)
-                .expect("the grains and coupling were checked when set");
-        }
-        timers.time(Stage::Stress, || self.stress(&bc, dt));
-        timers.time(Stage::Forces, || self.forces(&bc, dt));
-        let contact = timers.time(Stage::Contact, || {
-            self.contact(&bc, dt)?;
-            self.grains(&bc, dt)
+        t.time(Stage::KernelSums, || s.kernel_sums());
+        s.grain_porosity();
+        t.time(Stage::Stress, || {
+            s.stress();
+            s.fluid_density();
         });
-        timers.time(Stage::Rigid, || self.rigid(dt));
-        let checked = timers.time(Stage::Integrate, || self.integrate(&bc, dt));
-        self.timers = timers;
-        contact?;
-        checked?;
+        t.time(Stage::Forces, || {
+            s.forces();
+            s.fluid_forces();
+        });
+        // A failed contact skips the grains but not the integration, and is the failure reported.
+        let contact = t.time(Stage::Contact, || {
+            s.contact()?;
+            s.grain_coupling()?;
+            s.grain_contact();
+            s.grain_dem()
+        });
+        t.time(Stage::Rigid, || s.rigid());
+        let checked = t.time(Stage::Integrate, || s.integrate());
+        if let Err(e) = contact.and(checked) {
+            self.timers = timers;
+            return Err(e);
+        }
         self.time += dt;
         self.steps += 1;
-        let mut timers = std::mem::take(&mut self.timers);
-        let r = timers.time(Stage::Housekeeping, || self.housekeeping(&bc));
+        timers.time(Stage::Housekeeping, || {
+            self.filter_and_delete(&bc);
+            self.flow_step(dt);
+            self.grain_outflow_step();
+            self.dt = self.compute_dt();
+        });
         self.timers = timers;
         debug_assert!(self.particles.len() <= n || !self.flow.inflows.is_empty());
-        r
+        Ok(())
     }
 
     /// Runs one stage of `step` (docs/design.md "Engine step") on the current state without
@@ -344,24 +315,33 @@ impl World {
         if self.dt == 0.0 {
             self.dt = self.compute_dt();
         }
-        let dt = self.dt;
         let bc = self.kept_body_consts();
         let ready = self.nbrs_valid && self.scratch.pairs.count.len() == self.particles.len();
         if stage != Stage::Neighbours && !ready {
             // Every later stage reads the neighbour lists and the kernel-sum caches.
             self.rebuild_neighbours();
-            self.kernel_sums(&bc);
+            self.begin_step(&bc).kernel_sums();
         }
+        if stage == Stage::Neighbours {
+            self.rebuild_neighbours();
+            return Ok(());
+        }
+        let mut s = self.begin_step(&bc);
         match stage {
-            Stage::Neighbours => self.rebuild_neighbours(),
             // The rates are summed in the kernel sums' pass.
-            Stage::KernelSums | Stage::Rates => self.kernel_sums(&bc),
-            Stage::Stress => self.stress(&bc, dt),
-            Stage::Forces => self.forces(&bc, dt),
+            Stage::KernelSums | Stage::Rates => s.kernel_sums(),
+            Stage::Stress => {
+                s.stress();
+                s.fluid_density();
+            }
+            Stage::Forces => {
+                s.forces();
+                s.fluid_forces();
+            }
             Stage::Contact => {
-                stages::volumes(&self.particles, &mut self.scratch.vol);
+                stages::volumes(s.ctx.p, &mut s.scratch.vol);
                 // A surface particle passing through is a result of the state, not of timing.
-                let _ = self.contact(&bc, dt);
+                let _ = s.contact();
             }
             other => {
                 return Err(InputError::new(
@@ -405,9 +385,9 @@ impl World {
         Ok(self.steps - s0)
     }
 
-    /// Shepard density filter (eq. 12) every `shepard_interval` steps, deletion of particles with
-    /// D ≥ 1 and of fluid particles out of their density range, and the next time step.
-    fn housekeeping(&mut self, bc: &[BodyConst]) -> Result<(), SimError> {
+    /// Shepard density filter (eq. 12) every `shepard_interval` steps, and deletion of particles
+    /// with D ≥ 1 and of fluid particles out of their density range.
+    fn filter_and_delete(&mut self, bc: &[BodyConst]) {
         let every = self.settings.shepard_interval as u64;
         if every > 0 && self.steps.is_multiple_of(every) {
             self.filter_density_with(bc);
@@ -435,10 +415,6 @@ impl World {
             let keep: Vec<bool> = failed.iter().map(|f| !f).collect();
             self.retain_particles(&keep);
         }
-        self.flow_step(self.dt);
-        self.grain_outflow_step();
-        self.dt = self.compute_dt();
-        Ok(())
     }
 
     /// Runs the configured density filter now (eq. 12, or its MLS form) and books the change
@@ -453,253 +429,11 @@ impl World {
         if !self.nbrs_valid || self.nbrs.same.start.len() != self.particles.len() + 1 {
             self.rebuild_neighbours();
         }
-        stages::volumes(&self.particles, &mut self.scratch.vol);
-        let s = self.sph(bc);
-        let vol = &self.scratch.vol;
-        self.particles.rho = stages::filter_density(s, vol, self.settings.density_filter);
+        let filter = self.settings.density_filter;
+        let s = self.begin_step(bc);
+        stages::volumes(s.ctx.p, &mut s.scratch.vol);
+        let rho = stages::filter_density(s.ctx.sph(), &s.scratch.vol, filter);
+        self.particles.rho = rho;
         self.work.density_filter += self.energy().elastic - before;
-    }
-
-    // The stage calls of `step` and `run_stage`: each hands one stage of `crate::stages` the
-    // arrays it reads and writes, and books what it returns.
-
-    /// What the SPH sums of the stages read.
-    fn sph<'a>(&'a self, bc: &'a [BodyConst]) -> SphView<'a> {
-        SphView {
-            p: &self.particles,
-            nl: &self.nbrs.same,
-            k: &self.kernel,
-            bc,
-        }
-    }
-
-    fn kernel_sums(&mut self, bc: &[BodyConst]) {
-        let s = SphView {
-            p: &self.particles,
-            nl: &self.nbrs.same,
-            k: &self.kernel,
-            bc,
-        };
-        let (hi, sc) = (&self.nbrs.half, &mut self.scratch);
-        stages::kernel_sums(s, hi, &mut sc.pairs, &mut sc.sums);
-    }
-
-    fn stress(&mut self, bc: &[BodyConst], dt: f64) {
-        let beta = self.settings.taylor_quinney;
-        let plastic_work = stages::stress(
-            &mut self.particles,
-            &self.bodies,
-            bc,
-            &self.scratch.sums.gradv,
-            beta,
-            dt,
-            &mut self.scratch.yield_memo,
-        );
-        self.work.plastic -= plastic_work;
-        if stages::any_fluid(bc) {
-            let s = SphView {
-                p: &self.particles,
-                nl: &self.nbrs.same,
-                k: &self.kernel,
-                bc,
-            };
-            let sc = &mut self.scratch;
-            stages::fluid_continuity(s, &self.nbrs.half, &sc.pairs, &mut sc.drho);
-            if self.nbrs.cross.pairs() > 0 {
-                stages::interface_continuity(s, &self.nbrs.cross, &mut sc.drho);
-            }
-            stages::fluid_density(&mut self.particles, bc, &sc.drho, dt);
-        }
-    }
-
-    fn forces(&mut self, bc: &[BodyConst], dt: f64) {
-        let s = SphView {
-            p: &self.particles,
-            nl: &self.nbrs.same,
-            k: &self.kernel,
-            bc,
-        };
-        let sc = &mut self.scratch;
-        stages::volumes(s.p, &mut sc.vol);
-        let hg = stages::forces(
-            s,
-            &self.nbrs.half,
-            &sc.pairs,
-            &sc.vol,
-            &sc.sums.shepard,
-            &sc.sums.gradv,
-            &self.settings,
-            dt,
-            &mut sc.acc,
-            &mut sc.pair_forces,
-        );
-        self.work.hourglass += hg;
-        if stages::any_fluid(bc) {
-            let g = self.settings.gravity_m_s2;
-            sc.state = stages::particle_state(s.p, bc);
-            let (hi, state) = (&self.nbrs.half, &sc.state);
-            stages::fluid_accelerations(s, hi, &sc.pairs, state, g, &mut sc.acc, &mut sc.theta);
-            if self.nbrs.cross.pairs() > 0 {
-                let av = self.settings.solid_viscosity;
-                let cross = &self.nbrs.cross;
-                stages::interface_forces(s, cross, state, av, &mut sc.acc, &mut sc.theta);
-            }
-            stages::wall_forces(s.p, bc, &sc.acc, &mut sc.wall_loads);
-        }
-    }
-
-    fn contact(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
-        let s = SphView {
-            p: &self.particles,
-            nl: &self.nbrs.same,
-            k: &self.kernel,
-            bc,
-        };
-        let through = stages::contact(
-            s,
-            &mut self.nbrs.contact,
-            &self.scratch.vol,
-            self.settings.spacing_m,
-            dt,
-            &mut self.contacts,
-            &mut self.bodies,
-            &mut self.scratch.contact_force,
-            &mut self.work.contact_damping,
-        );
-        let Some(PassedThrough {
-            pair,
-            particle: i,
-            distance,
-        }) = through
-        else {
-            return Ok(());
-        };
-        let c = &self.contacts[pair];
-        Err(SimError {
-            step: self.steps,
-            time_s: self.time,
-            what: format!(
-                "particle {} of body '{}' passed through the surface of body '{}': distance {:.3e} m < 0",
-                self.particles.id[i], self.bodies[c.secondary].name, self.bodies[c.primary].name, distance
-            ),
-        })
-    }
-
-    /// The grains' part of the step (`stages::abrasives`): coupling forces on grains and fluid,
-    /// the penalty contact with the deformable particles, then the grains' DEM sub-steps.
-    fn grains(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
-        let Some(ab) = self.abrasives.as_mut() else {
-            return Ok(());
-        };
-        let sc = &mut self.scratch;
-        stages::fresh_loads(ab, &mut sc.loads);
-        let err = |e: crate::error::InputError| SimError {
-            step: self.steps,
-            time_s: self.time,
-            what: format!("abrasives: {e}"),
-        };
-        if let Some(fb) = ab.fluid_body {
-            let fluid = self.bodies[fb].fluid().expect("checked by set_abrasives");
-            let p = &self.particles;
-            let (frame, eps, theta) = (&sc.frame, &sc.porosity, &sc.theta);
-            stages::coupling_forces(p, ab, fluid, frame, eps, theta, &mut sc.acc, &mut sc.loads)
-                .map_err(err)?;
-        }
-        let d_ini = self.settings.spacing_m;
-        let cf = &mut sc.contact_force;
-        let touches = stages::penalty(&self.particles, bc, ab, d_ini, dt, cf, &mut sc.loads);
-        let mut now = vec![false; ab.dem.grains.len()];
-        for &(g, normal_speed_m_s) in &touches {
-            now[g] = true;
-            let grain = &mut ab.dem.grains[g];
-            if !grain.in_contact {
-                ab.hits.push(GrainHit {
-                    t_s: self.time,
-                    speed_m_s: grain.vel.norm(),
-                    normal_speed_m_s,
-                    first: !grain.touched,
-                });
-            }
-            grain.touched = true;
-        }
-        for (grain, now) in ab.dem.grains.iter_mut().zip(now) {
-            grain.in_contact = now;
-        }
-        ab.steps_in_contact += touches.len() as u64;
-        ab.substeps = stages::advance(ab, dt, &sc.loads).map_err(err)?;
-        Ok(())
-    }
-
-    fn rigid(&mut self, dt: f64) {
-        let g = self.settings.gravity_m_s2;
-        stages::rigid(&mut self.bodies, &mut self.particles, g, self.time, dt);
-    }
-
-    /// Advances the internal energy of the energy-carrying solids over the step just
-    /// integrated, at the step's mean velocities: with them the stress forces' work on the
-    /// motion is exactly what the particles' energy gains (docs/jet.md#energy).
-    fn solid_energy(&mut self, bc: &[BodyConst], dt: f64) {
-        let sc = &mut self.scratch;
-        // The step's start velocities become its mean ones in place.
-        for (v, end) in sc.vel_start.iter_mut().zip(&self.particles.vel) {
-            *v = (*v + end) * 0.5;
-        }
-        let s = SphView {
-            p: &self.particles,
-            nl: &self.nbrs.same,
-            k: &self.kernel,
-            bc,
-        };
-        sc.heat.clear();
-        sc.heat.resize(s.p.len(), 0.0);
-        let (hi, sh, av) = (
-            &self.nbrs.half,
-            &sc.sums.shepard,
-            self.settings.solid_viscosity,
-        );
-        let v_mid = &sc.vel_start;
-        stages::solid_energy_rates(s, hi, &sc.pairs, sh, av, v_mid, &mut sc.heat);
-        stages::add_heat(&mut self.particles, &sc.heat, dt);
-    }
-
-    fn integrate(&mut self, bc: &[BodyConst], dt: f64) -> Result<(), SimError> {
-        let solid_energy = stages::any_solid_energy(bc);
-        if solid_energy {
-            self.scratch.vel_start.clone_from(&self.particles.vel);
-        }
-        let blowup = stages::integrate(
-            &mut self.particles,
-            &self.bodies,
-            bc,
-            self.kernel.h,
-            &self.scratch.acc,
-            &self.scratch.contact_force,
-            self.time,
-            dt,
-        );
-        let what = match blowup {
-            None => {
-                if solid_energy {
-                    self.solid_energy(bc, dt);
-                }
-                return Ok(());
-            }
-            Some(Blowup::Particle { index: i, what }) => {
-                let p = &self.particles;
-                format!(
-                    "particle {} of body '{}' at ({:.4e}, {:.4e}) m: {what}",
-                    p.id[i], self.bodies[p.body[i] as usize].name, p.pos[i].x, p.pos[i].y
-                )
-            }
-            Some(Blowup::Rigid { body }) => format!(
-                "rigid body '{}': position or velocity is not finite",
-                self.bodies[body].name
-            ),
-        };
-        Err(SimError {
-            step: self.steps,
-            time_s: self.time,
-            what,
-        })
     }
 }
