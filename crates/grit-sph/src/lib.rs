@@ -35,10 +35,10 @@ pub use contact::{cfl_matched_stiffness, ContactModel, ContactParams};
 pub use geometry::Polygon;
 pub use kernel::{Kernel, KernelKind};
 pub use math::{Matrix, Vector};
-pub use particles::Particles;
+pub use particles::{Particles, ParticlesState};
 pub use timers::{Stage, Timers};
 pub use world::{
     Abrasives, CeilingPass, DensityFilter, Energy, GrainOutflow, Inflow, Nozzle, NumericalWork,
-    Outflow, PenaltyParams, Settings, WallLoad, World,
+    Outflow, PenaltyParams, Settings, WallLoad, World, WorldState,
 };
 pub mod verification;

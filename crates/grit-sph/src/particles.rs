@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::InputError;
 use crate::math::{Matrix, Vector};
 
 /// Particle sits in the layer of its body that can touch another body (contact, eqs. 21–22).
@@ -145,6 +146,141 @@ impl Particles {
         ]
         .iter()
         .all(|&l| l == n)
+    }
+}
+
+/// The layout of [`ParticlesState`] this build writes and reads.
+pub const PARTICLES_STATE_VERSION: u32 = 1;
+
+/// Particles as a checkpoint keeps them (an impact sample's surface, a [`WorldState`]'s
+/// particles), under a layout version of their own, so [`Particles`] may change without changing
+/// checkpoints: every per-particle array, in this order, none ever left out, so a positional
+/// format (postcard) reads it as well as JSON. A change to these fields is a new version.
+///
+/// [`WorldState`]: crate::world::WorldState
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParticlesState {
+    /// Layout version ([`PARTICLES_STATE_VERSION`]). JSON without one is `Particles`' own
+    /// (checkpoints written before this type): the same arrays, read as version 1.
+    #[serde(default = "first_layout")]
+    version: u32,
+    id: Vec<u32>,
+    body: Vec<u32>,
+    flags: Vec<u8>,
+    pos: Vec<Vector>,
+    vel: Vec<Vector>,
+    mass: Vec<f64>,
+    rho: Vec<f64>,
+    rho0: Vec<f64>,
+    sdev: Vec<Matrix>,
+    eps_p: Vec<f64>,
+    eps_p_rate: Vec<f64>,
+    temp: Vec<f64>,
+    /// Empty while every particle's energy is zero (bodies without an energy equation), so such a
+    /// state is no larger than one written before energies existed; JSON may leave it out.
+    #[serde(default)]
+    energy: Vec<f64>,
+    damage: Vec<f64>,
+    def_grad: Vec<Matrix>,
+    x_ref: Vec<Vector>,
+    local: Vec<Vector>,
+}
+
+/// The layout a state that names none was written in.
+fn first_layout() -> u32 {
+    1
+}
+
+impl ParticlesState {
+    /// The layout version this state was written in.
+    pub fn version(&self) -> u32 {
+        self.version
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.id.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.id.is_empty()
+    }
+}
+
+impl Particles {
+    /// The particles' state for a checkpoint ([`Particles::from_state`] reads it back, bit for
+    /// bit).
+    pub fn state(&self) -> ParticlesState {
+        let zero_energy = self.energy.iter().all(|&e| e == 0.0);
+        ParticlesState {
+            version: PARTICLES_STATE_VERSION,
+            id: self.id.clone(),
+            body: self.body.clone(),
+            flags: self.flags.clone(),
+            pos: self.pos.clone(),
+            vel: self.vel.clone(),
+            mass: self.mass.clone(),
+            rho: self.rho.clone(),
+            rho0: self.rho0.clone(),
+            sdev: self.sdev.clone(),
+            eps_p: self.eps_p.clone(),
+            eps_p_rate: self.eps_p_rate.clone(),
+            temp: self.temp.clone(),
+            energy: if zero_energy {
+                Vec::new()
+            } else {
+                self.energy.clone()
+            },
+            damage: self.damage.clone(),
+            def_grad: self.def_grad.clone(),
+            x_ref: self.x_ref.clone(),
+            local: self.local.clone(),
+        }
+    }
+
+    /// The particles of a checkpoint's state. Refuses a layout version this build does not read
+    /// and arrays of different lengths; errors name `particles.<field>`.
+    pub fn from_state(state: ParticlesState) -> Result<Particles, InputError> {
+        if state.version != PARTICLES_STATE_VERSION {
+            return Err(InputError::new(
+                "particles.version",
+                format!(
+                    "layout {} is not the one this build reads ({PARTICLES_STATE_VERSION})",
+                    state.version
+                ),
+            ));
+        }
+        let n = state.id.len();
+        let mut p = Particles {
+            id: state.id,
+            body: state.body,
+            flags: state.flags,
+            pos: state.pos,
+            vel: state.vel,
+            mass: state.mass,
+            rho: state.rho,
+            rho0: state.rho0,
+            sdev: state.sdev,
+            eps_p: state.eps_p,
+            eps_p_rate: state.eps_p_rate,
+            temp: state.temp,
+            energy: state.energy,
+            damage: state.damage,
+            def_grad: state.def_grad,
+            x_ref: state.x_ref,
+            local: state.local,
+        };
+        if p.energy.is_empty() {
+            p.energy = vec![0.0; n];
+        }
+        if !p.is_consistent() {
+            return Err(InputError::new(
+                "particles",
+                format!("arrays of different lengths (id holds {n})"),
+            ));
+        }
+        Ok(p)
     }
 }
 

@@ -10,6 +10,7 @@ mod build;
 mod diagnostics;
 mod flow;
 mod settings;
+mod state;
 mod step;
 
 pub use crate::stages::{CeilingPass, WallLoad, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
@@ -17,6 +18,7 @@ pub use abrasives::{plane_mass, Abrasives, GrainContacts, GrainHit, GrainOutflow
 pub use diagnostics::{Energy, NumericalWork};
 pub use flow::{Inflow, Nozzle, Outflow};
 pub use settings::{DensityFilter, Settings, MAX_CFL};
+pub use state::{WorldState, WORLD_STATE_VERSION};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
