@@ -55,7 +55,7 @@ fn chromium() -> &'static str {
     assert!(
         Path::new(CHROMIUM).exists(),
         "{CHROMIUM} is missing: the dashboard test drives headless Chromium. Install it with \
-         `apt-get install -y chromium` (.ci/run does this)."
+         `apt-get install -y chromium` (scripts/test does this)."
     );
     CHROMIUM
 }

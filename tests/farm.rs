@@ -249,14 +249,14 @@ async fn stale_worker_gets_409_and_changes_nothing() {
     assert_eq!(fresh.job_id, job.job_id);
     let hb = grit_farm::api::HeartbeatRequest {
         lease_id: job.lease_id,
-        impacts: vec![record.clone()],
+        units: grit_farm::api::units(&[record.clone()]),
         checkpoint: None,
     };
     let e = stale.heartbeat(job.job_id, &hb).await.unwrap_err();
     assert_eq!(e.status().map(|s| s.as_u16()), Some(409), "{e}");
     let done = grit_farm::api::CompleteRequest {
         lease_id: job.lease_id,
-        impacts: vec![record],
+        units: grit_farm::api::units(&[record]),
         checkpoint: None,
     };
     let e = stale.complete(job.job_id, &done).await.unwrap_err();

@@ -366,16 +366,16 @@ async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed
     })
     .await
     .unwrap();
-    let good = Checkpoint::of_sample(a.job_id, &one);
+    let good = Checkpoint::of(a.job_id, &one);
     let hb = HeartbeatRequest {
         lease_id: a.lease_id,
-        impacts: one.records().to_vec(),
+        units: grit_farm::api::units(one.records()),
         checkpoint: Some(good.clone()),
     };
     assert_eq!(wc.heartbeat(a.job_id, &hb).await.unwrap().impacts_done, 1);
 
     let bytes = two.checkpoint();
-    let next = Checkpoint::of_sample(a.job_id, &two);
+    let next = Checkpoint::of(a.job_id, &two);
     let half = &bytes[..bytes.len() / 2];
     let mut flipped = bytes.clone();
     flipped[bytes.len() / 2] ^= 0x10;
@@ -459,7 +459,7 @@ async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed
     for (job, lease) in [(a.job_id, a.lease_id), (b.job_id, b.lease_id)] {
         let back = ReleaseRequest {
             lease_id: lease,
-            impacts: vec![],
+            units: vec![],
             checkpoint: None,
         };
         wc.release(job, &back).await.unwrap();
@@ -475,7 +475,7 @@ async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed
     );
     let back = ReleaseRequest {
         lease_id: again.lease_id,
-        impacts: vec![],
+        units: vec![],
         checkpoint: None,
     };
     wc.release(a.job_id, &back).await.unwrap();

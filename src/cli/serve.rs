@@ -159,7 +159,7 @@ pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
     let summary = worker::run(client, opts, stop).await?;
     tracing::info!(
         jobs = summary.jobs_done,
-        impacts = summary.impacts,
+        units = summary.units,
         "worker stopped"
     );
     Ok(ExitCode::SUCCESS)

@@ -21,7 +21,7 @@ fn main() {
         .map(|s| s.parse().unwrap())
         .unwrap_or(5);
     let mut w = mid_contact_world(spacing, 100).expect("a stable scene");
-    w.run_stage(Stage::Rates).unwrap();
+    w.run_stage(Stage::KernelSums).unwrap();
     let pools: Vec<rayon::ThreadPool> = [1, 2]
         .iter()
         .map(|&t| {
@@ -34,7 +34,6 @@ fn main() {
     let stages = [
         ("neighbours", Some(Stage::Neighbours)),
         ("kernel_sums", Some(Stage::KernelSums)),
-        ("rates", Some(Stage::Rates)),
         ("stress", Some(Stage::Stress)),
         ("forces", Some(Stage::Forces)),
         ("contact", Some(Stage::Contact)),

@@ -30,7 +30,7 @@
 //! Configurations (45°, hexagon, Δx = 16 µm, aim range 0.5 Dg unless named):
 //! `small` 2.5 × 1.25 Dg; `wide` 3.75 × 1.875 Dg; `wide-r1` the same with aim range 1.0 Dg;
 //! `shallow` 2.5 × 1.024 Dg (16 particle layers). The `sponge` configuration of the records in
-//! `docs/erosion/compression/` (the shallow box with an absorbing layer) went with the layer
+//! `notebook/erosion/compression/` (the shallow box with an absorbing layer) went with the layer
 //! (docs/performance.md, "An absorbing layer").
 //! Each config writes `OUT_DIR/<config>.csv` and a checkpoint `OUT_DIR/<config>.ckpt`; rerun
 //! with a larger `--impacts` to go on from the checkpoint.

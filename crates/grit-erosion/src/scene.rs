@@ -41,9 +41,15 @@ pub trait Scene: Sized + Send + 'static {
     /// Runs the next unit; `Ok(None)` when `cancel` returned true before it ended, the state
     /// then being as [`Scene::CHECKPOINT_EACH_UNIT`] says.
     fn run_next(&mut self, cancel: &dyn Fn() -> bool) -> Result<Option<Self::Record>, SceneError>;
-    /// Checks a record a worker reports against its job's parameters (a scene's own rules:
-    /// masses, times); the error names the field and the rule.
-    fn check_record(params: &Self::Params, record: &Self::Record) -> Result<(), InputError>;
+    /// Checks a record a worker reports against its job's parameters and the job's mass loss
+    /// before it (kg/m, as this method returned for the record before; 0 for the first): the
+    /// scene's own rules on masses and times, the error naming the record's field. Returns the
+    /// job's mass loss after the record.
+    fn check_record(
+        params: &Self::Params,
+        record: &Self::Record,
+        lost_before_kg_m: f64,
+    ) -> Result<f64, InputError>;
 }
 
 /// Why a scene could not start, resume or run a unit.

@@ -1,4 +1,5 @@
-//! Every campaign spec the repository ships (examples/ and the specs under docs/) parses,
+//! Every campaign spec the repository ships (examples/ and the specs under docs/ and
+//! notebook/) parses,
 //! validates and expands into jobs, so a command quoted in the README or docs cannot fail on
 //! its own input.
 
@@ -29,6 +30,7 @@ fn every_shipped_campaign_spec_parses_validates_and_expands() {
     specs_in(&root.join("examples"), &mut specs);
     let in_examples = specs.len();
     specs_in(&root.join("docs"), &mut specs);
+    specs_in(&root.join("notebook"), &mut specs);
     assert!(in_examples >= 12, "examples/ has {in_examples} specs");
     for path in &specs {
         let text = std::fs::read_to_string(path).unwrap();

@@ -97,16 +97,50 @@ fn checkpoint_of_another_job_or_garbage_is_refused() {
         refusal(&flipped)
     );
     assert!(refusal(&bytes[..bytes.len() - 5]).starts_with("truncated"));
-    // A checkpoint written before the checksum (version 5, the same layout without it) reads.
-    let body = &bytes[..bytes.len() - 32];
-    let mut old = body.to_vec();
     assert_eq!(
-        old[0],
+        bytes[0],
         grit_erosion::impact::sample::CHECKPOINT_VERSION as u8
     );
-    old[0] = 5;
-    let back = Sample::from_checkpoint(&old).unwrap();
-    assert_eq!(back.seed(), 5);
+    // Checkpoints written before the surface had a state type of its own (version 6, `Particles`
+    // in its own layout, then the checksum) and before the checksum (version 5) read, and go on
+    // as the sample they were taken from.
+    let mut s = s;
+    s.run_next().unwrap();
+    for version in [5u32, 6] {
+        let old = old_checkpoint(&s, version);
+        let mut back = Sample::from_checkpoint(&old).unwrap();
+        assert_eq!(back.seed(), 5);
+        assert_eq!(bits(back.surface()), bits(s.surface()));
+        assert_eq!(back.checkpoint(), s.checkpoint());
+        back.run_next().unwrap();
+    }
+}
+
+/// `s`'s checkpoint as a build before `ParticlesState` wrote it: version 6 with its checksum,
+/// version 5 without.
+fn old_checkpoint(s: &Sample, version: u32) -> Vec<u8> {
+    use sha2::{Digest, Sha256};
+    #[derive(serde::Serialize)]
+    struct Old<'a> {
+        version: u32,
+        params_json: String,
+        seed: u64,
+        surface: &'a Particles,
+        records: &'a [ImpactRecord],
+    }
+    let old = Old {
+        version,
+        params_json: serde_json::to_string(s.params()).unwrap(),
+        seed: s.seed(),
+        surface: s.surface(),
+        records: s.records(),
+    };
+    let mut bytes = postcard::to_stdvec(&old).unwrap();
+    if version == 6 {
+        let digest = Sha256::digest(&bytes);
+        bytes.extend_from_slice(&digest);
+    }
+    bytes
 }
 
 #[test]

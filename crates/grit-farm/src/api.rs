@@ -7,6 +7,7 @@ use grit_erosion::campaign::Scene;
 use grit_erosion::jet::JetParams;
 use grit_erosion::{CampaignResults, ImpactParams, ImpactRecord};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde_json::Value;
 use utoipa::ToSchema;
 use uuid::Uuid;
 
@@ -431,17 +432,19 @@ impl Serialize for ClaimedJob {
     }
 }
 
-/// Heartbeat: renews the lease and delivers finished impacts and optionally a checkpoint.
+/// Heartbeat: renews the lease and delivers finished units (impacts of an impact job, slices
+/// of a jet job) and optionally a checkpoint.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HeartbeatRequest {
     /// The lease id from the claim.
     pub lease_id: Uuid,
-    /// Impacts finished since the last acknowledged heartbeat, in order; impacts already
-    /// stored are ignored, so a retried heartbeat is harmless.
-    #[serde(default)]
+    /// Units finished since the last acknowledged heartbeat, in order, as the job's scene
+    /// records them (`ImpactRecord`, `JetSlice`); units already stored are ignored, so a
+    /// retried heartbeat is harmless. Also read under the names `impacts` and `slices`.
+    #[serde(default, alias = "impacts", alias = "slices")]
     #[schema(value_type = Vec<Object>)]
-    pub impacts: Vec<ImpactRecord>,
+    pub units: Vec<Value>,
     /// A checkpoint to keep as the job's latest.
     #[serde(default)]
     pub checkpoint: Option<Checkpoint>,
@@ -450,24 +453,24 @@ pub struct HeartbeatRequest {
 /// Answer to a heartbeat.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 pub struct HeartbeatResponse {
-    /// Impacts now stored for the job.
+    /// Units now stored for the job (scripts rely on the name `impacts_done`).
     pub impacts_done: u32,
     /// New lease expiry, Unix milliseconds.
     pub lease_expires_ms: i64,
 }
 
-/// Completion: the last impacts; the job must then have all its planned impacts.
+/// Completion: the last units; the job must then have all its planned units.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CompleteRequest {
     /// The lease id from the claim.
     pub lease_id: Uuid,
-    /// Impacts not yet acknowledged.
-    #[serde(default)]
+    /// Units not yet acknowledged (also read as `impacts` and `slices`).
+    #[serde(default, alias = "impacts", alias = "slices")]
     #[schema(value_type = Vec<Object>)]
-    pub impacts: Vec<ImpactRecord>,
-    /// The state after the last impact, for a job claimed `extendable`; kept until its cell
-    /// is final.
+    pub units: Vec<Value>,
+    /// The state after the last unit, for a job claimed `extendable`; kept until its cell is
+    /// final.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub checkpoint: Option<Checkpoint>,
 }
@@ -480,10 +483,10 @@ pub struct FailRequest {
     pub lease_id: Uuid,
     /// What went wrong.
     pub error: String,
-    /// Impacts finished before the failure.
-    #[serde(default)]
+    /// Units finished before the failure (also read as `impacts` and `slices`).
+    #[serde(default, alias = "impacts", alias = "slices")]
     #[schema(value_type = Vec<Object>)]
-    pub impacts: Vec<ImpactRecord>,
+    pub units: Vec<Value>,
 }
 
 /// Release: give the job back without counting an attempt (a worker shutting down).
@@ -492,13 +495,21 @@ pub struct FailRequest {
 pub struct ReleaseRequest {
     /// The lease id from the claim.
     pub lease_id: Uuid,
-    /// Impacts not yet acknowledged.
-    #[serde(default)]
+    /// Units not yet acknowledged (also read as `impacts` and `slices`).
+    #[serde(default, alias = "impacts", alias = "slices")]
     #[schema(value_type = Vec<Object>)]
-    pub impacts: Vec<ImpactRecord>,
+    pub units: Vec<Value>,
     /// A checkpoint to resume from.
     #[serde(default)]
     pub checkpoint: Option<Checkpoint>,
+}
+
+/// Records as the JSON values a worker's requests carry (every f64 kept to the bit).
+pub fn units<R: Serialize>(records: &[R]) -> Vec<Value> {
+    records
+        .iter()
+        .map(|r| serde_json::to_value(r).expect("a scene's record always serialises"))
+        .collect()
 }
 
 /// Every error body: a message, and the offending field when there is one.

@@ -1,13 +1,12 @@
-//! Checkpoint envelopes: the bytes of `grit_erosion::Sample::checkpoint` with the job they
-//! belong to, their length and their SHA-256, and the one check both ends run on them. The
-//! coordinator refuses an upload that fails it (nothing of that request is stored), and a
-//! worker that gets a stored checkpoint failing it starts the sample again from impact 0.
-//! A jet job's checkpoints (`grit_erosion::jet::JetRun::checkpoint` bytes, counting slices)
-//! go through the same envelope checks ([`verify_jet`]).
+//! Checkpoint envelopes: the bytes of a scene's checkpoint (`grit_erosion::Scene::checkpoint`)
+//! with the job they belong to, their length and their SHA-256, and the one check both ends run
+//! on them, for every scene. The coordinator refuses an upload that fails it (nothing of that
+//! request is stored), and a worker that gets a stored checkpoint failing it starts the job
+//! again from its first unit.
 
 use base64::Engine;
-use grit_erosion::jet::{JetError, JetParams, JetRun};
-use grit_erosion::{ImpactParams, Sample, SampleError};
+use grit_erosion::jet::{JetParams, JetRun};
+use grit_erosion::{ImpactParams, Sample, Scene, SceneError};
 use sha2::{Digest, Sha256};
 
 use crate::api::Checkpoint;
@@ -29,14 +28,9 @@ impl Checkpoint {
         }
     }
 
-    /// The envelope of `sample`'s state now, as job `job_id`.
-    pub fn of_sample(job_id: i64, sample: &Sample) -> Checkpoint {
-        Checkpoint::from_bytes(job_id, sample.impacts_done(), &sample.checkpoint())
-    }
-
-    /// The envelope of jet run `run`'s state after its last finished slice, as job `job_id`.
-    pub fn of_jet(job_id: i64, run: &JetRun) -> Checkpoint {
-        Checkpoint::from_bytes(job_id, run.slices_done(), &run.checkpoint())
+    /// The envelope of `run`'s state after its last finished unit, as job `job_id`.
+    pub fn of<S: Scene>(job_id: i64, run: &S) -> Checkpoint {
+        Checkpoint::from_bytes(job_id, run.units_done(), &run.checkpoint())
     }
 }
 
@@ -87,85 +81,39 @@ fn refuse(field: &'static str, rule: impl Into<String>) -> CheckpointError {
 /// `sha256` (a flipped byte); they decode as a checkpoint (bytes cut short with the envelope
 /// rebuilt around them) of this job's scene and seed (another job's bytes); and they hold
 /// `impacts_done` impacts.
-pub fn verify(
+pub fn verify<S: Scene>(
     c: &Checkpoint,
     job_id: i64,
-    params: &ImpactParams,
+    params: &S::Params,
     seed: u64,
-) -> Result<Sample, CheckpointError> {
-    verify_upload(c, job_id, params, seed).map(|(sample, _)| sample)
+) -> Result<S, CheckpointError> {
+    verify_upload::<S>(c, job_id, params, seed).map(|(run, _)| run)
 }
 
 /// [`verify`], also handing back the checked bytes and their SHA-256 for the store to keep.
-pub fn verify_upload(
+pub fn verify_upload<S: Scene>(
     c: &Checkpoint,
     job_id: i64,
-    params: &ImpactParams,
+    params: &S::Params,
     seed: u64,
-) -> Result<(Sample, CheckpointBytes), CheckpointError> {
+) -> Result<(S, CheckpointBytes), CheckpointError> {
     let (bytes, actual) = envelope(c, job_id)?;
-    let sample = Sample::resume(params, seed, &bytes).map_err(|e| {
+    let run = S::resume(params, seed, &bytes).map_err(|e| {
         let rule = match e {
             // Its text starts with "checkpoint: " already.
-            SampleError::Checkpoint(_) => e.to_string(),
+            SceneError::Checkpoint(_) => e.to_string(),
             other => format!("checkpoint: {other}"),
         };
         refuse("checkpoint.data_b64", rule)
     })?;
-    if sample.impacts_done() != c.impacts_done {
+    if run.units_done() != c.impacts_done {
         return Err(refuse(
             "checkpoint.impacts_done",
             format!(
-                "is {} but the checkpoint holds {} impacts",
+                "is {} but the checkpoint holds {} {}s",
                 c.impacts_done,
-                sample.impacts_done()
-            ),
-        ));
-    }
-    let bytes = CheckpointBytes {
-        impacts_done: c.impacts_done,
-        bytes,
-        sha256: actual,
-    };
-    Ok((sample, bytes))
-}
-
-/// [`verify`] for a jet job: `c` as job `job_id`'s checkpoint of the jet run `params` seeded
-/// `seed`, its `impacts_done` counting slices; returns the run it resumes. The envelope checks
-/// are [`verify`]'s; the bytes must decode as a `JetRun` checkpoint of this build, of this run
-/// and seed, holding `impacts_done` slices.
-pub fn verify_jet(
-    c: &Checkpoint,
-    job_id: i64,
-    params: &JetParams,
-    seed: u64,
-) -> Result<JetRun, CheckpointError> {
-    verify_jet_upload(c, job_id, params, seed).map(|(run, _)| run)
-}
-
-/// [`verify_jet`], also handing back the checked bytes and their SHA-256 for the store.
-pub fn verify_jet_upload(
-    c: &Checkpoint,
-    job_id: i64,
-    params: &JetParams,
-    seed: u64,
-) -> Result<(JetRun, CheckpointBytes), CheckpointError> {
-    let (bytes, actual) = envelope(c, job_id)?;
-    let run = JetRun::resume(params, seed, &bytes).map_err(|e| {
-        let rule = match e {
-            // "checkpoint cannot decode: …", "checkpoint belongs to another run …".
-            JetError::Checkpoint(m) => format!("checkpoint: {m}"),
-            other => format!("checkpoint: {other}"),
-        };
-        refuse("checkpoint.data_b64", rule)
-    })?;
-    if run.slices_done() != c.impacts_done {
-        return Err(refuse(
-            "checkpoint.impacts_done",
-            format!(
-                "is {} but the checkpoint holds {} slices",
-                c.impacts_done,
-                run.slices_done()
+                run.units_done(),
+                S::UNIT
             ),
         ));
     }
@@ -186,8 +134,8 @@ pub enum JobParams {
     Jet(JetParams),
 }
 
-/// [`verify_upload`] or [`verify_jet_upload`] as the job's scene says, handing back only the
-/// checked bytes: what the coordinator keeps of an upload.
+/// [`verify_upload`] of the job's scene, handing back only the checked bytes: what the
+/// coordinator keeps of an upload.
 pub fn verify_any_upload(
     c: &Checkpoint,
     job_id: i64,
@@ -195,8 +143,8 @@ pub fn verify_any_upload(
     seed: u64,
 ) -> Result<CheckpointBytes, CheckpointError> {
     match params {
-        JobParams::Impact(p) => verify_upload(c, job_id, p, seed).map(|(_, b)| b),
-        JobParams::Jet(p) => verify_jet_upload(c, job_id, p, seed).map(|(_, b)| b),
+        JobParams::Impact(p) => verify_upload::<Sample>(c, job_id, p, seed).map(|(_, b)| b),
+        JobParams::Jet(p) => verify_upload::<JetRun>(c, job_id, p, seed).map(|(_, b)| b),
     }
 }
 
@@ -279,11 +227,11 @@ mod tests {
         let params = coarse();
         let sample = Sample::new(params.clone(), 3).unwrap();
         let bytes = sample.checkpoint();
-        (params, Checkpoint::of_sample(7, &sample), bytes)
+        (params, Checkpoint::of(7, &sample), bytes)
     }
 
     fn refused(c: &Checkpoint, params: &ImpactParams, seed: u64) -> CheckpointError {
-        verify(c, 7, params, seed).expect_err("refused")
+        verify::<Sample>(c, 7, params, seed).expect_err("refused")
     }
 
     #[test]
@@ -291,16 +239,16 @@ mod tests {
         let (params, c, bytes) = good();
         assert_eq!(c.size_bytes, bytes.len() as u64);
         assert_eq!(c.sha256.len(), 64);
-        let s = verify(&c, 7, &params, 3).unwrap();
+        let s = verify::<Sample>(&c, 7, &params, 3).unwrap();
         assert_eq!(s.checkpoint(), bytes);
         // Upper-case hex is the same checksum.
         let upper = Checkpoint {
             sha256: c.sha256.to_ascii_uppercase(),
             ..c
         };
-        assert!(verify(&upper, 7, &params, 3).is_ok());
+        assert!(verify::<Sample>(&upper, 7, &params, 3).is_ok());
         // What the store keeps: the very bytes, and their checksum in lowercase.
-        let (_, kept) = verify_upload(&upper, 7, &params, 3).unwrap();
+        let (_, kept) = verify_upload::<Sample>(&upper, 7, &params, 3).unwrap();
         assert_eq!(kept, CheckpointBytes::new(0, bytes));
         assert_eq!(kept.sha256, c.sha256);
     }
@@ -325,23 +273,23 @@ mod tests {
     fn a_jet_checkpoint_resumes_its_run_and_only_its_own() {
         let p = tiny_jet();
         let run = JetRun::new(p.clone(), 5).unwrap();
-        let c = Checkpoint::of_jet(7, &run);
-        let back = verify_jet(&c, 7, &p, 5).unwrap();
+        let c = Checkpoint::of(7, &run);
+        let back = verify::<JetRun>(&c, 7, &p, 5).unwrap();
         assert_eq!(back.checkpoint(), run.checkpoint());
         let kept = verify_any_upload(&c, 7, &JobParams::Jet(p.clone()), 5).unwrap();
         assert_eq!(kept.bytes, run.checkpoint());
-        let e = verify_jet(&c, 7, &p, 6).unwrap_err();
+        let e = verify::<JetRun>(&c, 7, &p, 6).unwrap_err();
         assert_eq!(e.field, "checkpoint.data_b64");
         assert!(e.rule.contains("belongs to another run"), "{e}");
         assert_eq!(
-            verify_jet(&c, 8, &p, 5).unwrap_err().field,
+            verify::<JetRun>(&c, 8, &p, 5).unwrap_err().field,
             "checkpoint.job_id"
         );
         let count = Checkpoint {
             impacts_done: 1,
             ..c.clone()
         };
-        let e = verify_jet(&count, 7, &p, 5).unwrap_err();
+        let e = verify::<JetRun>(&count, 7, &p, 5).unwrap_err();
         assert_eq!(e.rule, "is 1 but the checkpoint holds 0 slices");
         // An impact checkpoint is no jet checkpoint, and the other way round.
         let (ip, ic, _) = good();
@@ -360,7 +308,7 @@ mod tests {
     #[test]
     fn another_jobs_envelope_is_refused_naming_both_jobs() {
         let (params, c, _) = good();
-        let e = verify(&c, 8, &params, 3).unwrap_err();
+        let e = verify::<Sample>(&c, 8, &params, 3).unwrap_err();
         assert_eq!(e.field, "checkpoint.job_id");
         assert_eq!(e.rule, "the checkpoint belongs to job 7, not job 8");
     }

@@ -241,7 +241,7 @@ impl Client {
         Self::json(resp).await.map(Some)
     }
 
-    /// Renews a lease, delivering impacts and maybe a checkpoint.
+    /// Renews a lease, delivering finished units and maybe a checkpoint.
     pub async fn heartbeat(
         &self,
         job: i64,
@@ -265,38 +265,6 @@ impl Client {
 
     /// Gives a job back.
     pub async fn release(&self, job: i64, req: &ReleaseRequest) -> Result<(), ClientError> {
-        self.post_empty(&format!("/worker/jobs/{job}/release"), req)
-            .await
-    }
-
-    /// Renews a jet job's lease, delivering slices and maybe a checkpoint.
-    pub async fn heartbeat_jet(
-        &self,
-        job: i64,
-        req: &JetHeartbeatRequest,
-    ) -> Result<HeartbeatResponse, ClientError> {
-        self.post(&format!("/worker/jobs/{job}/heartbeat"), req)
-            .await
-    }
-
-    /// Completes a jet job.
-    pub async fn complete_jet(
-        &self,
-        job: i64,
-        req: &JetCompleteRequest,
-    ) -> Result<(), ClientError> {
-        self.post_empty(&format!("/worker/jobs/{job}/complete"), req)
-            .await
-    }
-
-    /// Reports a failed attempt at a jet job.
-    pub async fn fail_jet(&self, job: i64, req: &JetFailRequest) -> Result<(), ClientError> {
-        self.post_empty(&format!("/worker/jobs/{job}/fail"), req)
-            .await
-    }
-
-    /// Gives a jet job back.
-    pub async fn release_jet(&self, job: i64, req: &JetReleaseRequest) -> Result<(), ClientError> {
         self.post_empty(&format!("/worker/jobs/{job}/release"), req)
             .await
     }

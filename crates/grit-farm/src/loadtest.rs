@@ -9,7 +9,7 @@ use grit_erosion::campaign::{CampaignSpec, MAX_JOBS};
 use grit_erosion::{ImpactOutcome, ImpactRecord};
 use serde::Serialize;
 
-use crate::api::{CompleteRequest, HeartbeatRequest};
+use crate::api::{units, CompleteRequest, HeartbeatRequest};
 use crate::client::{Client, ClientError};
 use crate::db::{Store, Synchronous};
 use crate::server::{self, Config, Secret};
@@ -199,7 +199,7 @@ async fn client_loop(client: Client, name: String, deadline: Instant) -> Tally {
                 job.job_id,
                 &HeartbeatRequest {
                     lease_id: job.lease_id,
-                    impacts: vec![],
+                    units: vec![],
                     checkpoint: None,
                 },
             )
@@ -216,7 +216,7 @@ async fn client_loop(client: Client, name: String, deadline: Instant) -> Tally {
                 job.job_id,
                 &CompleteRequest {
                     lease_id: job.lease_id,
-                    impacts: vec![record],
+                    units: units(&[record]),
                     checkpoint: None,
                 },
             )

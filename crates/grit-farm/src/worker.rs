@@ -1,22 +1,23 @@
-//! The worker loop: claim a job, run its impacts in order (each in a blocking thread, rayon
-//! inside the engine), report every finished impact by heartbeat, upload a checkpoint every K
-//! impacts, complete. On stop it abandons the running impact through the engine's cancel
-//! callback, uploads a checkpoint and releases the lease. A jet job runs slice by slice
-//! instead (`jet`), with a checkpoint after every slice.
+//! The worker loop, one for every scene (`grit_erosion::Scene`): claim a job, run its units
+//! (impacts, jet slices) in order, each in a blocking thread with rayon inside the engine,
+//! report every finished unit by heartbeat, upload a checkpoint every K units, complete. On
+//! stop it abandons the running unit through the engine's cancel callback, hands back the
+//! state after the last finished unit and releases the lease.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use grit_erosion::{ImpactRecord, Sample};
+use grit_erosion::jet::JetRun;
+use grit_erosion::{Sample, Scene};
+use serde::Serialize;
+use serde_json::Value;
 
 use crate::api::{
-    Checkpoint, ClaimedJob, CompleteRequest, FailRequest, HeartbeatRequest, ReleaseRequest,
+    units, Checkpoint, ClaimedJob, CompleteRequest, FailRequest, HeartbeatRequest, ReleaseRequest,
 };
 use crate::checkpoint::verify;
 use crate::client::{Client, ClientError};
-
-mod jet;
 
 /// A stop request shared by a signal handler, the async loop and the engine's cancel callback.
 #[derive(Clone)]
@@ -105,10 +106,8 @@ pub fn default_name() -> String {
 pub struct WorkerSummary {
     /// Jobs completed.
     pub jobs_done: u64,
-    /// Impacts simulated.
-    pub impacts: u64,
-    /// Jet slices simulated.
-    pub slices: u64,
+    /// Units simulated: impacts, jet slices.
+    pub units: u64,
 }
 
 /// A failure that stops the worker (bad token, an answer it cannot understand).
@@ -200,136 +199,153 @@ pub async fn run(
 }
 
 impl Runner {
-    /// The sample to continue: from the checkpoint when it passes `checkpoint::verify` (its
-    /// job, length, checksum and decoding), else from scratch (impacts the coordinator already
-    /// has are re-run and skipped by it, bit-identical).
-    fn open_sample(job: &ClaimedJob) -> Result<Sample, String> {
+    /// The run to continue: from the checkpoint when it passes `checkpoint::verify` (its job,
+    /// length, checksum and decoding), else from the start (units the coordinator already has
+    /// are run again, bit-identical, and skipped by it).
+    fn open<S: Scene>(job: &ClaimedJob, params: &S::Params) -> Result<S, String> {
         if let Some(c) = &job.checkpoint {
-            match verify(c, job.job_id, &job.params, job.seed) {
-                Ok(s) => {
+            match verify::<S>(c, job.job_id, params, job.seed) {
+                Ok(run) => {
                     tracing::info!(
                         job = job.job_id,
-                        impacts = s.impacts_done(),
+                        units = run.units_done(),
                         "resumed from checkpoint"
                     );
-                    return Ok(s);
+                    return Ok(run);
                 }
                 Err(e) => {
-                    tracing::warn!(job = job.job_id, error = %e, "checkpoint unusable; starting the sample again")
+                    tracing::warn!(job = job.job_id, error = %e, "checkpoint unusable; starting the job again")
                 }
             }
         }
-        Sample::new(job.params.clone(), job.seed).map_err(|e| e.to_string())
+        S::start(params, job.seed).map_err(|e| e.to_string())
     }
 
     async fn run_job(&mut self, job: ClaimedJob) -> JobEnd {
-        if let Some(params) = job.jet.clone() {
-            return self.run_jet_job(job, params).await;
+        match job.jet.clone() {
+            Some(params) => self.run::<JetRun>(job, params).await,
+            None => {
+                let params = job.params.clone();
+                self.run::<Sample>(job, params).await
+            }
         }
-        let mut sample = match Self::open_sample(&job) {
-            Ok(s) => s,
+    }
+
+    /// Runs job `job` of scene `S` unit by unit (each in a blocking thread, rayon inside the
+    /// engine), reporting every finished unit by heartbeat, with a checkpoint every
+    /// `checkpoint_every` units (every unit where a cancelled unit leaves the state
+    /// mid-unit, `Scene::CHECKPOINT_EACH_UNIT`), and completes it.
+    async fn run<S: Scene>(&mut self, job: ClaimedJob, params: S::Params) -> JobEnd {
+        let mut run = match Self::open::<S>(&job, &params) {
+            Ok(r) => r,
             Err(e) => {
-                let req = FailRequest {
-                    lease_id: job.lease_id,
-                    error: format!("cannot set up the sample: {e}"),
-                    impacts: vec![],
-                };
-                if let Err(e) = self.client.fail(job.job_id, &req).await {
-                    tracing::warn!(error = %e, "reporting the failure failed");
-                }
-                return JobEnd::Failed;
+                return self
+                    .fail(&job, format!("cannot set up the job: {e}"), vec![])
+                    .await
             }
         };
-        let mut pending: Vec<ImpactRecord> = sample
+        let mut pending: Vec<S::Record> = run
             .records()
-            .iter()
-            .filter(|r| r.impact > job.impacts_done)
-            .cloned()
+            .into_iter()
+            .filter(|r| S::unit_of(r) > job.impacts_done)
             .collect();
+        // The state after the last finished unit, for a scene whose cancelled unit leaves it
+        // mid-unit; until a unit is done here, the coordinator's stored checkpoint is newest.
+        let mut last: Option<Checkpoint> = None;
         let tick = Duration::from_secs_f64((job.lease_ttl_s / 3.0).max(0.2));
         let lost = Arc::new(AtomicBool::new(false));
+        let every = if S::CHECKPOINT_EACH_UNIT {
+            1
+        } else {
+            self.opts.checkpoint_every.max(1)
+        };
         let mut checkpoint_due = false;
-        while sample.impacts_done() < job.impacts_planned {
+        while run.units_done() < job.impacts_planned {
             if self.stop.is_set() {
-                return self.release(&job, &sample, pending).await;
+                return self.release(&job, &run, pending, last).await;
             }
             let stop = self.stop.clone();
             let lost_flag = lost.clone();
             let pool = self.pool.clone();
+            let (job_id, planned) = (job.job_id, job.impacts_planned);
             let mut handle = tokio::task::spawn_blocking(move || {
                 let cancel = || stop.is_set() || lost_flag.load(Ordering::SeqCst);
                 let result = match &pool {
                     // The pool is this worker's own: one world steps on it at a time.
-                    Some(p) => grit_sph::polling::install_polling(p, || {
-                        sample.run_next_cancellable(&cancel).cloned()
-                    }),
-                    None => sample.run_next_cancellable(&cancel).cloned(),
+                    Some(p) => grit_sph::polling::install_polling(p, || run.run_next(&cancel)),
+                    None => run.run_next(&cancel),
                 };
-                (sample, result)
+                // Serialising a large state takes milliseconds: here, not on the async threads.
+                let checkpoint = (matches!(result, Ok(Some(_)))
+                    && run.units_done() % every == 0
+                    && run.units_done() < planned)
+                    .then(|| Checkpoint::of(job_id, &run));
+                (run, result, checkpoint)
             });
-            // Keep the lease alive while the impact runs (it can take minutes).
-            let (s, result) = loop {
+            // Keep the lease alive while the unit runs (an impact can take minutes).
+            let (r, result, checkpoint) = loop {
                 tokio::select! {
                     joined = &mut handle => match joined {
                         Ok(v) => break v,
-                        Err(e) => return self.fail(&job, format!("impact thread panicked: {e}"), pending).await,
+                        Err(e) => return self.fail(&job, format!("{} thread panicked: {e}", S::UNIT), units(&pending)).await,
                     },
                     _ = tokio::time::sleep(tick) => {
                         match self.heartbeat(&job, &mut pending, None).await {
                             Ok(()) => {}
-                            Err(Some(why)) => { lost.store(true, Ordering::SeqCst); tracing::warn!(%why, "lease lost; abandoning the impact"); }
+                            Err(Some(why)) => { lost.store(true, Ordering::SeqCst); tracing::warn!(%why, "lease lost; abandoning the {}", S::UNIT); }
                             Err(None) => {}
                         }
                     }
                 }
             };
-            sample = s;
+            run = r;
             match result {
-                Ok(rec) => {
-                    self.summary.impacts += 1;
+                Ok(Some(rec)) => {
+                    self.summary.units += 1;
                     tracing::info!(
                         job = job.job_id,
-                        impact = rec.impact,
-                        mass_loss_kg = rec.mass_loss_kg,
-                        "impact done"
+                        unit = S::unit_of(&rec),
+                        "{} done",
+                        S::UNIT
                     );
                     pending.push(rec);
+                    if checkpoint.is_some() {
+                        checkpoint_due = true;
+                        last = checkpoint;
+                    }
                 }
-                Err(_) if lost.load(Ordering::SeqCst) => {
-                    return JobEnd::Lost("lease lost while the impact ran".into())
+                _ if lost.load(Ordering::SeqCst) => {
+                    return JobEnd::Lost(format!("lease lost while the {} ran", S::UNIT))
                 }
-                Err(_) if self.stop.is_set() => return self.release(&job, &sample, pending).await,
-                Err(e) => return self.fail(&job, e.to_string(), pending).await,
+                // Cancelled: hand back the state after the last finished unit.
+                Ok(None) => return self.release(&job, &run, pending, last).await,
+                Err(_) if self.stop.is_set() => {
+                    return self.release(&job, &run, pending, last).await
+                }
+                Err(e) => return self.fail(&job, e.to_string(), units(&pending)).await,
             }
-            if sample.impacts_done() % self.opts.checkpoint_every.max(1) == 0
-                && sample.impacts_done() < job.impacts_planned
-            {
-                checkpoint_due = true;
-            }
-            let ckpt = checkpoint_due.then(|| Checkpoint::of_sample(job.job_id, &sample));
+            let ckpt = if checkpoint_due { last.clone() } else { None };
             match self.heartbeat(&job, &mut pending, ckpt).await {
                 Ok(()) => checkpoint_due = false,
                 Err(Some(why)) => return JobEnd::Lost(why),
                 Err(None) => {}
             }
         }
-        let last = job
-            .extendable
-            .then(|| Checkpoint::of_sample(job.job_id, &sample));
-        self.complete(&job, pending, last).await
+        let end = job.extendable.then(|| Checkpoint::of(job.job_id, &run));
+        self.complete(&job, units(&pending), end).await
     }
 
-    /// Sends the pending impacts; clears them once acknowledged. `Err(Some)` means the lease
-    /// is gone (409/410/404); `Err(None)` a transient failure (impacts kept for the next try).
-    async fn heartbeat(
+    /// Sends the pending units; clears them once acknowledged. `Err(Some)` means the lease is
+    /// gone (409/410/404); `Err(None)` a transient failure (units kept for the next try).
+    async fn heartbeat<R: Serialize>(
         &self,
         job: &ClaimedJob,
-        pending: &mut Vec<ImpactRecord>,
+        pending: &mut Vec<R>,
         checkpoint: Option<Checkpoint>,
     ) -> Result<(), Option<String>> {
         let req = HeartbeatRequest {
             lease_id: job.lease_id,
-            impacts: pending.clone(),
+            units: units(pending),
             checkpoint,
         };
         match self.client.heartbeat(job.job_id, &req).await {
@@ -338,7 +354,7 @@ impl Runner {
                 Ok(())
             }
             Err(e) if e.is_transient() => {
-                tracing::warn!(error = %e, pending = pending.len(), "heartbeat failed; impacts kept for the next one");
+                tracing::warn!(error = %e, pending = pending.len(), "heartbeat failed; units kept for the next one");
                 Err(None)
             }
             Err(e) => Err(Some(e.to_string())),
@@ -373,12 +389,12 @@ impl Runner {
     async fn complete(
         &self,
         job: &ClaimedJob,
-        pending: Vec<ImpactRecord>,
+        pending: Vec<Value>,
         checkpoint: Option<Checkpoint>,
     ) -> JobEnd {
         let req = CompleteRequest {
             lease_id: job.lease_id,
-            impacts: pending,
+            units: pending,
             checkpoint,
         };
         match self
@@ -393,12 +409,12 @@ impl Runner {
         }
     }
 
-    async fn fail(&self, job: &ClaimedJob, error: String, pending: Vec<ImpactRecord>) -> JobEnd {
+    async fn fail(&self, job: &ClaimedJob, error: String, pending: Vec<Value>) -> JobEnd {
         tracing::error!(job = job.job_id, %error, "job failed");
         let req = FailRequest {
             lease_id: job.lease_id,
             error,
-            impacts: pending,
+            units: pending,
         };
         if let Err(e) = self
             .deliver("fail", || self.client.fail(job.job_id, &req))
@@ -409,26 +425,34 @@ impl Runner {
         JobEnd::Failed
     }
 
-    async fn release(
+    /// Gives the job back with the state after its last finished unit: `run`'s own where a
+    /// cancelled unit leaves it untouched, else `last`, the checkpoint taken after that unit.
+    async fn release<S: Scene>(
         &self,
         job: &ClaimedJob,
-        sample: &Sample,
-        pending: Vec<ImpactRecord>,
+        run: &S,
+        pending: Vec<S::Record>,
+        last: Option<Checkpoint>,
     ) -> JobEnd {
+        let checkpoint = if S::CHECKPOINT_EACH_UNIT {
+            last
+        } else {
+            Some(Checkpoint::of(job.job_id, run))
+        };
+        let done = checkpoint.as_ref().map(|c| c.impacts_done);
         let req = ReleaseRequest {
             lease_id: job.lease_id,
-            impacts: pending,
-            checkpoint: Some(Checkpoint::of_sample(job.job_id, sample)),
+            units: units(&pending),
+            checkpoint,
         };
         match self
             .deliver("release", || self.client.release(job.job_id, &req))
             .await
         {
-            Ok(()) => tracing::info!(
-                job = job.job_id,
-                impacts = sample.impacts_done(),
-                "job released with a checkpoint"
-            ),
+            Ok(()) if done.is_some() => {
+                tracing::info!(job = job.job_id, ?done, "job released with a checkpoint")
+            }
+            Ok(()) => tracing::info!(job = job.job_id, "job released; its last checkpoint stands"),
             Err(e) => {
                 tracing::warn!(job = job.job_id, error = %e, "release failed; the lease will expire")
             }
@@ -477,8 +501,12 @@ mod tests {
         };
         let mut sample = Sample::new(params, 9).unwrap();
         sample.run_next().unwrap();
-        let good = Checkpoint::of_sample(4, &sample);
-        let resumed = Runner::open_sample(&job(&sample, Some(good.clone()))).unwrap();
+        let good = Checkpoint::of(4, &sample);
+        let open = |c| {
+            let j = job(&sample, c);
+            Runner::open::<Sample>(&j, &j.params)
+        };
+        let resumed = open(Some(good.clone())).unwrap();
         assert_eq!(resumed.impacts_done(), 1);
         assert_eq!(resumed.checkpoint(), sample.checkpoint());
 
@@ -489,10 +517,10 @@ mod tests {
             data_b64: base64::engine::general_purpose::STANDARD.encode(&bytes),
             ..good.clone()
         };
-        let fresh = Runner::open_sample(&job(&sample, Some(damaged))).unwrap();
+        let fresh = open(Some(damaged)).unwrap();
         assert_eq!(fresh.impacts_done(), 0);
         let other_job = Checkpoint { job_id: 5, ..good };
-        let fresh = Runner::open_sample(&job(&sample, Some(other_job))).unwrap();
+        let fresh = open(Some(other_job)).unwrap();
         assert_eq!(fresh.impacts_done(), 0);
     }
 }

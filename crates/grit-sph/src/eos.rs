@@ -11,7 +11,7 @@ use crate::error::InputError;
 
 /// Which pressure law a material follows; the default linear law is `p = K (ρ/ρ0 − 1)` (seed eq. 11).
 ///
-/// Kept an enum so a brittle model's polynomial EOS (JH-2, docs/jet.md#not-built-yet) is one
+/// Kept an enum so a brittle model's polynomial EOS (JH-2, docs/jet.md#open-points) is one
 /// more variant.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]

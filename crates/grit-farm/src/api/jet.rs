@@ -1,72 +1,12 @@
-//! The API bodies of jet campaigns (docs/jet-campaigns.md): what a worker reports for a jet
-//! job, whose unit of progress is a slice of simulated time, and a jet campaign's results.
-//! A jet job's heartbeat, complete, fail and release go to the same endpoints as an impact
-//! job's, with `slices` where an impact job sends `impacts`.
+//! The API bodies of jet campaigns' results (docs/jet-campaigns.md). A jet job's heartbeat,
+//! complete, fail and release are an impact job's, its units being slices.
 
 use grit_erosion::jet::aggregate::JetCampaignResults;
 use grit_erosion::jet::JetSlice;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
-use uuid::Uuid;
 
-use super::{Checkpoint, ResultsResponse};
-
-/// A jet job's heartbeat: renews the lease, delivers finished slices and maybe a checkpoint.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct JetHeartbeatRequest {
-    /// The lease id from the claim.
-    pub lease_id: Uuid,
-    /// Slices finished since the last acknowledged heartbeat, in order; slices already
-    /// stored are ignored, so a retried heartbeat is harmless.
-    #[serde(default)]
-    #[schema(value_type = Vec<Object>)]
-    pub slices: Vec<JetSlice>,
-    /// A checkpoint (`grit_erosion::jet::JetRun::checkpoint` bytes) to keep as the latest.
-    #[serde(default)]
-    pub checkpoint: Option<Checkpoint>,
-}
-
-/// A jet job's completion: the last slices; the job must then have all its planned slices.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct JetCompleteRequest {
-    /// The lease id from the claim.
-    pub lease_id: Uuid,
-    /// Slices not yet acknowledged.
-    #[serde(default)]
-    #[schema(value_type = Vec<Object>)]
-    pub slices: Vec<JetSlice>,
-}
-
-/// A jet job's failure report.
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct JetFailRequest {
-    /// The lease id from the claim.
-    pub lease_id: Uuid,
-    /// What went wrong.
-    pub error: String,
-    /// Slices finished before the failure.
-    #[serde(default)]
-    #[schema(value_type = Vec<Object>)]
-    pub slices: Vec<JetSlice>,
-}
-
-/// A jet job given back without counting an attempt (a worker shutting down).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct JetReleaseRequest {
-    /// The lease id from the claim.
-    pub lease_id: Uuid,
-    /// Slices not yet acknowledged.
-    #[serde(default)]
-    #[schema(value_type = Vec<Object>)]
-    pub slices: Vec<JetSlice>,
-    /// The checkpoint after the last finished slice, to resume from.
-    #[serde(default)]
-    pub checkpoint: Option<Checkpoint>,
-}
+use super::ResultsResponse;
 
 /// The slices of one jet sample (`?raw=true`).
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]

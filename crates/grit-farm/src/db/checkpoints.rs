@@ -32,4 +32,15 @@ impl Store {
         };
         Ok((params, r.get::<i64, _>(1) as u64))
     }
+
+    /// The scene of job `job_id`'s campaign (`campaigns.scene`: `impact` or `jet`).
+    pub async fn job_scene(&self, job_id: i64) -> Result<String> {
+        sqlx::query_scalar(
+            "SELECT k.scene FROM jobs j JOIN campaigns k ON k.id = j.campaign_id WHERE j.id = ?",
+        )
+        .bind(job_id)
+        .fetch_optional(&self.read)
+        .await?
+        .ok_or_else(|| Error::NotFound(format!("job {job_id}")))
+    }
 }

@@ -11,8 +11,8 @@
 use std::time::Duration;
 
 use base64::Engine;
-use grit_erosion::jet::{JetParams, JetSlice};
-use grit_erosion::{ImpactParams, ImpactRecord};
+use grit_erosion::jet::{JetParams, JetRun, JetSlice};
+use grit_erosion::{ImpactParams, ImpactRecord, Sample, Scene};
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
@@ -108,6 +108,8 @@ pub(super) struct NewImpact {
     impact: u32,
     grain_mass_kg: f64,
     mass_loss_kg: f64,
+    /// The record, for its scene's checks.
+    record: ImpactRecord,
     /// The whole record as JSON, with round-trip float formatting (every f64 comes back
     /// bit for bit).
     json: String,
@@ -117,22 +119,12 @@ pub(super) struct NewImpact {
 fn serialised(impacts: &[ImpactRecord]) -> Result<Vec<NewImpact>> {
     impacts
         .iter()
-        .enumerate()
-        .map(|(i, rec)| {
-            // The record says the loss twice; both come from one number in a worker.
-            if rec.mass_loss_kg.to_bits() != rec.outcome.mass_loss_kg.to_bits() {
-                return Err(Error::invalid(
-                    format!("impacts[{i}].mass_loss_kg"),
-                    format!(
-                        "must equal outcome.mass_loss_kg ({:e}), got {:e}",
-                        rec.outcome.mass_loss_kg, rec.mass_loss_kg
-                    ),
-                ));
-            }
+        .map(|rec| {
             Ok(NewImpact {
                 impact: rec.impact,
                 grain_mass_kg: rec.grain_mass_kg,
                 mass_loss_kg: rec.mass_loss_kg,
+                record: rec.clone(),
                 json: serde_json::to_string(rec).map_err(|e| Error::Internal(e.to_string()))?,
             })
         })
@@ -144,6 +136,8 @@ pub(super) struct NewSlice {
     slice: u32,
     t_s: f64,
     mass_loss_kg_m: f64,
+    /// The record, for its scene's checks.
+    record: JetSlice,
     /// The whole `JetSlice` as JSON, with round-trip float formatting.
     json: String,
 }
@@ -157,6 +151,7 @@ fn serialised_slices(slices: &[JetSlice]) -> Result<Vec<NewSlice>> {
                 slice: s.slice,
                 t_s: s.sample.t_s,
                 mass_loss_kg_m: s.sample.mass_loss_kg_m,
+                record: s.clone(),
                 json: serde_json::to_string(s).map_err(|e| Error::Internal(e.to_string()))?,
             })
         })
@@ -782,38 +777,14 @@ async fn store_impacts(
             Some(p) => p,
             None => scene.insert(stored_params::<ImpactParams>(job_id, &held.params)?),
         };
-        // The worker computes the grain mass from these very params, so it matches to the bit.
-        let grain = p.grain_mass_kg_m();
-        if rec.grain_mass_kg.to_bits() != grain.to_bits() {
-            return Err(Error::invalid(
-                field("grain_mass_kg"),
-                format!(
-                    "must be the cell's grain mass {grain:e} kg/m, got {:e}",
-                    rec.grain_mass_kg
-                ),
-            ));
-        }
-        let surface = p.surface_mass_kg_m();
-        if !(rec.mass_loss_kg.is_finite() && rec.mass_loss_kg >= 0.0) {
-            return Err(Error::invalid(
-                field("mass_loss_kg"),
-                format!("must be finite and ≥ 0, got {:e}", rec.mass_loss_kg),
-            ));
-        }
         let before = match lost {
             Some(l) => l,
-            None => *lost.insert(stored_loss(tx, job_id).await?),
+            None => stored_loss(tx, job_id).await?,
         };
-        lost = Some(before + rec.mass_loss_kg);
-        if before + rec.mass_loss_kg > surface {
-            return Err(Error::invalid(
-                field("mass_loss_kg"),
-                format!(
-                    "brings the sample's loss to {:e} kg/m, more than the surface's mass {surface:e} kg/m",
-                    before + rec.mass_loss_kg
-                ),
-            ));
-        }
+        lost = Some(
+            Sample::check_record(p, &rec.record, before)
+                .map_err(|e| Error::invalid(field(&e.field), e.rule))?,
+        );
         new.push(rec);
         done = rec.impact;
     }
@@ -856,27 +827,8 @@ async fn store_slices(
             Some(p) => p,
             None => scene.insert(stored_params::<JetParams>(job_id, &held.params)?),
         };
-        // A slice ends at the first step past its end time: within a slice of it.
-        let end = (p.time_ms + p.slice_ms) * 1e-3;
-        if !(rec.t_s.is_finite() && (0.0..=end).contains(&rec.t_s)) {
-            return Err(Error::invalid(
-                field("sample.t_s"),
-                format!(
-                    "must be finite and in [0, {end:e}] s (the run's time and one slice), got {:e}",
-                    rec.t_s
-                ),
-            ));
-        }
-        let target = p.target_mass_kg_m();
-        if !(rec.mass_loss_kg_m.is_finite() && (0.0..=target).contains(&rec.mass_loss_kg_m)) {
-            return Err(Error::invalid(
-                field("sample.mass_loss_kg_m"),
-                format!(
-                    "must be finite, ≥ 0 and at most the target's mass {target:e} kg/m, got {:e}",
-                    rec.mass_loss_kg_m
-                ),
-            ));
-        }
+        JetRun::check_record(p, &rec.record, 0.0)
+            .map_err(|e| Error::invalid(field(&e.field), e.rule))?;
         new.push(rec);
         done = rec.slice;
     }

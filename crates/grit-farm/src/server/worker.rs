@@ -2,9 +2,9 @@
 //! impacts and checkpoints), complete, fail or release the job it holds. A checkpoint is
 //! verified (`crate::checkpoint::verify_upload`) before the store sees the request, so a
 //! refused one leaves nothing of its request stored, impacts included; the store gets the
-//! bytes and checksum that check produced, and decodes nothing again. A jet job reports
-//! `slices` where an impact job reports `impacts` (`JetHeartbeatRequest` and its kin), to the
-//! same endpoints; each body is read as the union of both forms.
+//! bytes and checksum that check produced, and decodes nothing again. A job reports its units
+//! (impacts, slices) as its scene records them, under `units` (or the older names `impacts`
+//! and `slices`); each body is read as the union of the four requests.
 
 use axum::body::Bytes;
 use axum::extract::{FromRequest, Path, Request, State};
@@ -15,6 +15,7 @@ use axum::{Json, Router};
 use grit_erosion::jet::JetSlice;
 use grit_erosion::ImpactRecord;
 use serde::Deserialize;
+use serde_json::Value;
 use uuid::Uuid;
 
 use super::AppState;
@@ -23,16 +24,14 @@ use crate::checkpoint::{verify_any_upload, CheckpointBytes};
 use crate::db::Reported;
 use crate::error::{Error, Result};
 
-/// A heartbeat, complete, fail or release body of either scene: `HeartbeatRequest` and
-/// `JetHeartbeatRequest` (and their kin) in one, each field optional as in both.
+/// A heartbeat, complete, fail or release body: `HeartbeatRequest` and its kin in one, each
+/// field optional as in all of them. Its units are decoded as the job's scene records them.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Report {
     lease_id: Uuid,
-    #[serde(default)]
-    impacts: Vec<ImpactRecord>,
-    #[serde(default)]
-    slices: Vec<JetSlice>,
+    #[serde(default, alias = "impacts", alias = "slices")]
+    units: Vec<Value>,
     #[serde(default)]
     checkpoint: Option<Checkpoint>,
     /// Only in a fail body.
@@ -40,12 +39,58 @@ struct Report {
     error: Option<String>,
 }
 
-impl Report {
+/// A report's units decoded as its job's scene's records.
+#[derive(Default)]
+struct Units {
+    impacts: Vec<ImpactRecord>,
+    slices: Vec<JetSlice>,
+}
+
+impl Units {
     fn reported(&self) -> Reported<'_> {
         Reported {
             impacts: &self.impacts,
             slices: &self.slices,
         }
+    }
+}
+
+/// Each of `units` as a record of `R`; a unit that is not one is a 422 naming its field.
+fn records<R: serde::de::DeserializeOwned>(units: Vec<Value>) -> Result<Vec<R>> {
+    units
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| {
+            serde_path_to_error::deserialize(v).map_err(|e| {
+                let path = e.path().to_string();
+                let at = if path == "." {
+                    format!("units[{i}]")
+                } else {
+                    format!("units[{i}].{path}")
+                };
+                Error::invalid(at, e.into_inner().to_string())
+            })
+        })
+        .collect()
+}
+
+impl Report {
+    /// The units as job `job`'s scene's records; 404 for an unknown job.
+    async fn units(&mut self, s: &AppState, job: i64) -> Result<Units> {
+        let units = std::mem::take(&mut self.units);
+        if units.is_empty() {
+            return Ok(Units::default());
+        }
+        Ok(match s.store.job_scene(job).await?.as_str() {
+            "jet" => Units {
+                slices: records(units)?,
+                ..Units::default()
+            },
+            _ => Units {
+                impacts: records(units)?,
+                ..Units::default()
+            },
+        })
     }
 
     /// The 422 for a field the endpoint does not take.
@@ -68,12 +113,7 @@ pub fn router() -> Router<AppState> {
 #[derive(utoipa::OpenApi)]
 #[openapi(
     paths(claim, heartbeat, complete, fail, release),
-    components(schemas(
-        JetHeartbeatRequest,
-        JetCompleteRequest,
-        JetFailRequest,
-        JetReleaseRequest
-    ))
+    components(schemas(HeartbeatRequest, CompleteRequest, FailRequest, ReleaseRequest))
 )]
 pub struct Doc;
 
@@ -190,7 +230,7 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/heartbeat", params(("job_id" = i64, Path)),
-    request_body(content = HeartbeatRequest, description = "a jet job sends JetHeartbeatRequest (`slices` for `impacts`)"),
+    request_body(content = HeartbeatRequest, description = "units as the job's scene records them"),
     responses((status = 200, body = HeartbeatResponse), (status = 401), (status = 404, body = ErrorBody),
         (status = 409, body = ErrorBody, description = "not the lease holder; nothing stored"),
         (status = 410, body = ErrorBody, description = "campaign cancelled; drop the job"),
@@ -205,16 +245,17 @@ async fn heartbeat(
     if req.error.is_some() {
         return Err(Report::refuse("error", "heartbeat"));
     }
+    let units = req.units(&s, job).await?;
     let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
     Ok(Json(
         s.store
-            .heartbeat_with(job, req.lease_id, req.reported(), checkpoint)
+            .heartbeat_with(job, req.lease_id, units.reported(), checkpoint)
             .await?,
     ))
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/complete", params(("job_id" = i64, Path)),
-    request_body(content = CompleteRequest, description = "a jet job sends JetCompleteRequest (`slices` for `impacts`)"),
+    request_body(content = CompleteRequest, description = "units as the job's scene records them"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody),
         (status = 410, body = ErrorBody), (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
@@ -227,21 +268,22 @@ async fn complete(
     if req.error.is_some() {
         return Err(Report::refuse("error", "complete"));
     }
+    let units = req.units(&s, job).await?;
     let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
     s.store
-        .complete_with(job, req.lease_id, req.reported(), checkpoint)
+        .complete_with(job, req.lease_id, units.reported(), checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/fail", params(("job_id" = i64, Path)),
-    request_body(content = FailRequest, description = "a jet job sends JetFailRequest (`slices` for `impacts`)"),
+    request_body(content = FailRequest, description = "units as the job's scene records them"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody)),
     security(("worker_token" = [])))]
 async fn fail(
     State(s): State<AppState>,
     Path(job): Path<String>,
-    ApiJson(req): ApiJson<Report>,
+    ApiJson(mut req): ApiJson<Report>,
 ) -> Result<StatusCode> {
     let job = job_id(&job)?;
     if req.checkpoint.is_some() {
@@ -253,14 +295,16 @@ async fn fail(
             "missing or empty: say what went wrong",
         ));
     };
+    let error = error.to_string();
+    let units = req.units(&s, job).await?;
     s.store
-        .fail_with(job, req.lease_id, error, req.reported())
+        .fail_with(job, req.lease_id, &error, units.reported())
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/release", params(("job_id" = i64, Path)),
-    request_body(content = ReleaseRequest, description = "a jet job sends JetReleaseRequest (`slices` for `impacts`)"),
+    request_body(content = ReleaseRequest, description = "units as the job's scene records them"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody),
         (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
@@ -273,9 +317,10 @@ async fn release(
     if req.error.is_some() {
         return Err(Report::refuse("error", "release"));
     }
+    let units = req.units(&s, job).await?;
     let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
     s.store
-        .release_with(job, req.lease_id, req.reported(), checkpoint)
+        .release_with(job, req.lease_id, units.reported(), checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }

@@ -296,16 +296,13 @@ pub fn flight_to_contact(params: &ImpactParams, surface: &Particles, grain: &Gra
         };
         surface.pos.iter().filter(|x| near(x)).any(|&xi| {
             let js = (0..moved.len()).filter(|&j| (xi - moved[j]).norm() < reach);
-            grit_sph::contact::detect(
-                params.numerics.contact_model,
-                &kernel,
+            grit_sph::contact::Detector {
+                model: params.numerics.contact_model,
+                kernel: &kernel,
                 dx,
-                1.0,
-                xi,
-                js,
-                &moved,
-                |_| 1.0,
-            )
+                k_r: 1.0,
+            }
+            .detect(xi, js, &moved, |_| 1.0)
             .is_some_and(|d| d.penetration > 0.0)
         })
     };

@@ -1,7 +1,7 @@
 //! A sample (seed section 4): one fresh surface hit by N impacts in order, fully determined by
 //! its parameters and seed, with a checkpoint after any impact that resumes bit for bit.
 
-use grit_sph::{Particles, Timers};
+use grit_sph::{InputError, Particles, ParticlesState, Timers};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -9,11 +9,13 @@ use crate::impact::aggregate::Impact;
 use crate::impact::{
     run_impact_observed, GrainStart, ImpactError, ImpactOutcome, ImpactParams, StepObserver,
 };
-use crate::scene::stream_draws;
+use crate::scene::{stream_draws, Scene, SceneError};
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
-pub const CHECKPOINT_VERSION: u32 = 6;
+pub const CHECKPOINT_VERSION: u32 = 7;
+/// The last version whose surface was `Particles`' own serde layout; still read.
+const PARTICLES_VERSION: u32 = 6;
 /// The version before checkpoints carried their checksum; still read.
 const UNCHECKED_VERSION: u32 = 5;
 /// Bytes of the SHA-256 checksum after a checkpoint's body.
@@ -71,6 +73,16 @@ struct Checkpoint {
     version: u32,
     /// JSON, because shapes and materials deserialise by looking at the data, which postcard
     /// (not self-describing) cannot do.
+    params_json: String,
+    seed: u64,
+    surface: ParticlesState,
+    records: Vec<ImpactRecord>,
+}
+
+/// A checkpoint of versions 5 and 6: the surface in `Particles`' own serde layout.
+#[derive(Deserialize)]
+struct CheckpointV6 {
+    _version: u32,
     params_json: String,
     seed: u64,
     #[serde(deserialize_with = "grit_sph::particles::deserialize_filled")]
@@ -203,7 +215,7 @@ impl Sample {
             version: CHECKPOINT_VERSION,
             params_json: serde_json::to_string(&self.params).expect("params serialise"),
             seed: self.seed,
-            surface: self.surface.clone(),
+            surface: self.surface.state(),
             records: self.records.clone(),
         };
         let mut bytes = postcard::to_stdvec(&c).expect("a checkpoint always serialises");
@@ -227,7 +239,7 @@ impl Sample {
     /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them (for
     /// replaying a job's checkpoint by hand; the farm uses `resume`).
     pub fn from_checkpoint(bytes: &[u8]) -> Result<Sample, SampleError> {
-        let (c, rest): (Checkpoint, &[u8]) = postcard::take_from_bytes(bytes).map_err(|e| {
+        let undecodable = |e| {
             SampleError::Checkpoint(match e {
                 postcard::Error::DeserializeUnexpectedEnd => {
                     "truncated: the bytes end before the checkpoint does, so it cannot decode"
@@ -235,9 +247,30 @@ impl Sample {
                 }
                 e => format!("cannot decode: {e}"),
             })
-        })?;
-        match c.version {
+        };
+        // The version comes first in every layout, and says how to read the rest.
+        let (version, _) = postcard::take_from_bytes::<u32>(bytes).map_err(undecodable)?;
+        let (c, rest) = match version {
             CHECKPOINT_VERSION => {
+                let (c, rest): (Checkpoint, &[u8]) =
+                    postcard::take_from_bytes(bytes).map_err(undecodable)?;
+                let surface = Particles::from_state(c.surface)
+                    .map_err(|e| SampleError::Checkpoint(format!("surface: {e}")))?;
+                ((c.params_json, c.seed, surface, c.records), rest)
+            }
+            PARTICLES_VERSION | UNCHECKED_VERSION => {
+                let (c, rest): (CheckpointV6, &[u8]) =
+                    postcard::take_from_bytes(bytes).map_err(undecodable)?;
+                ((c.params_json, c.seed, c.surface, c.records), rest)
+            }
+            v => {
+                return Err(SampleError::Checkpoint(format!(
+                    "cannot decode version {v}: this build reads {UNCHECKED_VERSION} to {CHECKPOINT_VERSION}"
+                )))
+            }
+        };
+        match version {
+            CHECKPOINT_VERSION | PARTICLES_VERSION => {
                 let body = &bytes[..bytes.len() - rest.len()];
                 if rest.len() != SHA256_LEN {
                     return Err(SampleError::Checkpoint(format!(
@@ -252,29 +285,131 @@ impl Sample {
                 }
             }
             // Written before checkpoints carried a checksum: read as they are.
-            UNCHECKED_VERSION if rest.is_empty() => {}
+            _ if rest.is_empty() => {}
             v => {
                 return Err(SampleError::Checkpoint(format!(
-                    "version {v} but this build reads {UNCHECKED_VERSION} and {CHECKPOINT_VERSION}"
+                    "version {v} holds {} bytes after its end",
+                    rest.len()
                 )))
             }
         }
-        let saved: ImpactParams = serde_json::from_str(&c.params_json)
+        let (params_json, seed, surface, records) = c;
+        let saved: ImpactParams = serde_json::from_str(&params_json)
             .map_err(|e| SampleError::Checkpoint(format!("cannot decode parameters: {e}")))?;
         saved.validate()?;
-        if !c.surface.is_consistent() {
+        if !surface.is_consistent() {
             return Err(SampleError::Checkpoint(
                 "surface arrays have different lengths".into(),
             ));
         }
         Ok(Sample {
             params: saved,
-            seed: c.seed,
-            surface: c.surface,
-            records: c.records,
+            seed,
+            surface,
+            records,
             last_timers: Timers::default(),
             last_particles: 0,
         })
+    }
+}
+
+impl Scene for Sample {
+    const KIND: &'static str = "impact";
+    const UNIT: &'static str = "impact";
+    // A cancelled impact leaves the sample as it was after the last one.
+    const CHECKPOINT_EACH_UNIT: bool = false;
+    type Params = ImpactParams;
+    type Record = ImpactRecord;
+
+    fn start(params: &ImpactParams, seed: u64) -> Result<Sample, SceneError> {
+        Sample::new(params.clone(), seed).map_err(|e| SceneError::Run(e.to_string()))
+    }
+
+    fn resume(params: &ImpactParams, seed: u64, bytes: &[u8]) -> Result<Sample, SceneError> {
+        Sample::resume(params, seed, bytes).map_err(SceneError::from)
+    }
+
+    fn checkpoint(&self) -> Vec<u8> {
+        Sample::checkpoint(self)
+    }
+
+    fn units_done(&self) -> u32 {
+        self.impacts_done()
+    }
+
+    fn records(&self) -> Vec<ImpactRecord> {
+        self.records.clone()
+    }
+
+    fn unit_of(record: &ImpactRecord) -> u32 {
+        record.impact
+    }
+
+    fn run_next(&mut self, cancel: &dyn Fn() -> bool) -> Result<Option<ImpactRecord>, SceneError> {
+        match self.run_next_cancellable(cancel) {
+            Ok(r) => Ok(Some(r.clone())),
+            Err(SampleError::Impact {
+                error: ImpactError::Cancelled,
+                ..
+            }) => Ok(None),
+            Err(e) => Err(SceneError::Run(e.to_string())),
+        }
+    }
+
+    /// The loss is stated once (the record's and its outcome's agree to the bit), the grain
+    /// mass is the cell's to the bit (the worker computes it from these very parameters), the
+    /// loss is finite and ≥ 0, and the sample's total stays within the surface's mass.
+    fn check_record(
+        params: &ImpactParams,
+        record: &ImpactRecord,
+        lost_before_kg_m: f64,
+    ) -> Result<f64, InputError> {
+        // The record says the loss twice; both come from one number in a worker.
+        if record.mass_loss_kg.to_bits() != record.outcome.mass_loss_kg.to_bits() {
+            return Err(InputError::new(
+                "mass_loss_kg",
+                format!(
+                    "must equal outcome.mass_loss_kg ({:e}), got {:e}",
+                    record.outcome.mass_loss_kg, record.mass_loss_kg
+                ),
+            ));
+        }
+        let grain = params.grain_mass_kg_m();
+        if record.grain_mass_kg.to_bits() != grain.to_bits() {
+            return Err(InputError::new(
+                "grain_mass_kg",
+                format!(
+                    "must be the cell's grain mass {grain:e} kg/m, got {:e}",
+                    record.grain_mass_kg
+                ),
+            ));
+        }
+        if !(record.mass_loss_kg.is_finite() && record.mass_loss_kg >= 0.0) {
+            return Err(InputError::new(
+                "mass_loss_kg",
+                format!("must be finite and ≥ 0, got {:e}", record.mass_loss_kg),
+            ));
+        }
+        let after = lost_before_kg_m + record.mass_loss_kg;
+        let surface = params.surface_mass_kg_m();
+        if after > surface {
+            return Err(InputError::new(
+                "mass_loss_kg",
+                format!(
+                    "brings the sample's loss to {after:e} kg/m, more than the surface's mass {surface:e} kg/m"
+                ),
+            ));
+        }
+        Ok(after)
+    }
+}
+
+impl From<SampleError> for SceneError {
+    fn from(e: SampleError) -> SceneError {
+        match e {
+            SampleError::Checkpoint(m) => SceneError::Checkpoint(m),
+            e => SceneError::Run(e.to_string()),
+        }
     }
 }
 

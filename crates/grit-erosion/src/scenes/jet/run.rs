@@ -3,11 +3,12 @@
 
 use grit_sph::crater::{self, CraterOptions, CraterSample};
 use grit_sph::world::GrainContacts;
-use grit_sph::{InputError, SimError, Timers, World};
+use grit_sph::{InputError, SimError, Timers, World, WorldState};
 use serde::{Deserialize, Serialize};
 
 use super::feed::Feed;
 use super::scene::{self, Layout};
+use crate::scene::{Scene, SceneError};
 use crate::stats::{stats, Stats};
 
 use super::params::*;
@@ -121,13 +122,14 @@ pub struct JetRun {
 }
 
 /// What a checkpoint holds; the world goes as JSON (its optional parts are skipped when
-/// absent, which only a self-describing format reads back).
+/// absent, which only a self-describing format reads back). A world written before
+/// `WorldState` existed has no version of its own and reads as its version 1.
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
     version: u32,
     params: JetParams,
     seed: u64,
-    world: World,
+    world: WorldState,
     feed: Feed,
     slices: Vec<JetSlice>,
 }
@@ -318,7 +320,7 @@ impl JetRun {
             version: CHECKPOINT_VERSION,
             params: self.params.clone(),
             seed: self.seed,
-            world: self.world.clone(),
+            world: self.world.state(),
             feed: self.feed.clone(),
             slices: self.slices.clone(),
         };
@@ -356,8 +358,10 @@ impl JetRun {
                 i + 1
             )));
         }
+        let world = World::from_state(c.world)
+            .map_err(|e| JetError::Checkpoint(format!("cannot decode: {e}")))?;
         let n = c.slices.len() as u32;
-        let t = c.world.time();
+        let t = world.time();
         let from = if n == 0 {
             0.0
         } else {
@@ -375,9 +379,80 @@ impl JetRun {
             params: c.params,
             seed: c.seed,
             layout,
-            world: c.world,
+            world,
             feed: c.feed,
             slices: c.slices,
         })
+    }
+}
+impl Scene for JetRun {
+    const KIND: &'static str = "jet";
+    const UNIT: &'static str = "slice";
+    // A cancelled slice leaves the world mid-slice.
+    const CHECKPOINT_EACH_UNIT: bool = true;
+    type Params = JetParams;
+    type Record = JetSlice;
+
+    fn start(params: &JetParams, seed: u64) -> Result<JetRun, SceneError> {
+        JetRun::new(params.clone(), seed).map_err(|e| SceneError::Run(e.to_string()))
+    }
+
+    fn resume(params: &JetParams, seed: u64, bytes: &[u8]) -> Result<JetRun, SceneError> {
+        JetRun::resume(params, seed, bytes).map_err(|e| match e {
+            JetError::Checkpoint(m) => SceneError::Checkpoint(m),
+            e => SceneError::Run(e.to_string()),
+        })
+    }
+
+    fn checkpoint(&self) -> Vec<u8> {
+        JetRun::checkpoint(self)
+    }
+
+    fn units_done(&self) -> u32 {
+        self.slices_done()
+    }
+
+    fn records(&self) -> Vec<JetSlice> {
+        self.slices.clone()
+    }
+
+    fn unit_of(record: &JetSlice) -> u32 {
+        record.slice
+    }
+
+    fn run_next(&mut self, cancel: &dyn Fn() -> bool) -> Result<Option<JetSlice>, SceneError> {
+        self.run_next_slice_observed(cancel, None)
+            .map(|s| s.cloned())
+            .map_err(|e| SceneError::Run(e.to_string()))
+    }
+
+    /// A slice ends at the first step past its end time, so within one slice of the run's
+    /// time; its mass loss, the run's so far, lies between 0 and the target's mass.
+    fn check_record(
+        params: &JetParams,
+        record: &JetSlice,
+        _lost_before_kg_m: f64,
+    ) -> Result<f64, InputError> {
+        let end = (params.time_ms + params.slice_ms) * 1e-3;
+        let t = record.sample.t_s;
+        if !(t.is_finite() && (0.0..=end).contains(&t)) {
+            return Err(InputError::new(
+                "sample.t_s",
+                format!(
+                    "must be finite and in [0, {end:e}] s (the run's time and one slice), got {t:e}"
+                ),
+            ));
+        }
+        let target = params.target_mass_kg_m();
+        let loss = record.sample.mass_loss_kg_m;
+        if !(loss.is_finite() && (0.0..=target).contains(&loss)) {
+            return Err(InputError::new(
+                "sample.mass_loss_kg_m",
+                format!(
+                    "must be finite, ≥ 0 and at most the target's mass {target:e} kg/m, got {loss:e}"
+                ),
+            ));
+        }
+        Ok(loss)
     }
 }
