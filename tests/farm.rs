@@ -249,7 +249,7 @@ async fn stale_worker_gets_409_and_changes_nothing() {
     assert_eq!(fresh.job_id, job.job_id);
     let hb = grit_farm::api::HeartbeatRequest {
         lease_id: job.lease_id,
-        units: grit_farm::api::units(&[record.clone()]),
+        units: grit_farm::api::units(std::slice::from_ref(&record)),
         checkpoint: None,
     };
     let e = stale.heartbeat(job.job_id, &hb).await.unwrap_err();
