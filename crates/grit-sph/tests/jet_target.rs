@@ -4,22 +4,12 @@
 
 mod common;
 
-use common::{flow_bits, stepped_on};
+use common::{flow_bits, lattice, stepped_on};
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
 use grit_sph::{Abrasives, Fluid, Material, PenaltyParams, Settings, Vector, World};
 
 const DX: f64 = 1e-4;
-
-fn lattice(nx: usize, ny: usize, origin: Vector) -> Vec<Vector> {
-    let mut pts = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            pts.push(origin + Vector::new((i as f64 + 0.5) * DX, (j as f64 + 0.5) * DX));
-        }
-    }
-    pts
-}
 
 /// A grain set without grains or walls, garnet constants, no gravity.
 fn no_grains() -> Dem {
@@ -36,7 +26,7 @@ fn no_grains() -> Dem {
 /// down onto it at `speed`, and, with `grains`, garnet grains in the water coupled to it.
 fn water_on_copper(speed: f64, grains: bool) -> World {
     let mut w = World::new(Settings::water_jet(DX, Vector::zeros())).unwrap();
-    let target = lattice(20, 8, Vector::new(0.0, -8.0 * DX));
+    let target = lattice(DX, 20, 8, Vector::new(0.0, -8.0 * DX));
     let vols = vec![DX * DX; target.len()];
     w.add_deformable(
         "target",
@@ -46,7 +36,7 @@ fn water_on_copper(speed: f64, grains: bool) -> World {
         Vector::zeros(),
     )
     .unwrap();
-    let water = lattice(12, 8, Vector::new(4.0 * DX, 0.0));
+    let water = lattice(DX, 12, 8, Vector::new(4.0 * DX, 0.0));
     let (vols, pres) = (vec![DX * DX; water.len()], vec![0.0; water.len()]);
     let v = Vector::new(0.0, -speed);
     let b = w

@@ -3,6 +3,9 @@
 //! before the state types existed reads as version 1; a layout this build does not know, or
 //! arrays that do not fit together, are refused by name.
 
+mod common;
+
+use common::lattice;
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
 use grit_sph::particles::{ParticlesState, PARTICLES_STATE_VERSION};
@@ -16,21 +19,11 @@ use serde_json::Value;
 
 const DX: f64 = 1e-4;
 
-fn lattice(nx: usize, ny: usize, origin: Vector) -> Vec<Vector> {
-    let mut pts = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            pts.push(origin + Vector::new((i as f64 + 0.5) * DX, (j as f64 + 0.5) * DX));
-        }
-    }
-    pts
-}
-
 /// Every part a state holds: a copper target (Mie–Grüneisen, so its particles carry an energy),
 /// water falling onto it from a nozzle, an outflow, and two garnet grains coupled to the water.
 fn jet_on_copper() -> World {
     let mut w = World::new(Settings::water_jet(DX, Vector::new(0.0, -9.81))).unwrap();
-    let target = lattice(20, 8, Vector::new(0.0, -8.0 * DX));
+    let target = lattice(DX, 20, 8, Vector::new(0.0, -8.0 * DX));
     let vols = vec![DX * DX; target.len()];
     w.add_deformable(
         "target",
@@ -40,7 +33,7 @@ fn jet_on_copper() -> World {
         Vector::zeros(),
     )
     .unwrap();
-    let water = lattice(12, 4, Vector::new(4.0 * DX, 0.0));
+    let water = lattice(DX, 12, 4, Vector::new(4.0 * DX, 0.0));
     let (vols, pres) = (vec![DX * DX; water.len()], vec![0.0; water.len()]);
     let b = w
         .add_fluid(

@@ -1,7 +1,20 @@
-//! Helpers shared by the fluid tests: a world stepped on a given number of threads, and the
-//! bits of its flow state for the thread-count determinism contract (docs/design.md).
+//! Helpers shared by the fluid and state tests: a world stepped on a given number of threads,
+//! the bits of its flow state for the thread-count determinism contract (docs/design.md), and
+//! a lattice of particle positions. Each test file uses some of them.
+#![allow(dead_code)]
 
-use grit_sph::World;
+use grit_sph::{Vector, World};
+
+/// Cell centres of an `nx` × `ny` lattice of spacing `dx` whose lower left corner is `origin`.
+pub fn lattice(dx: f64, nx: usize, ny: usize, origin: Vector) -> Vec<Vector> {
+    let mut pts = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            pts.push(origin + Vector::new((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx));
+        }
+    }
+    pts
+}
 
 /// `world` stepped `steps` times inside a rayon pool of `threads` threads.
 pub fn stepped_on(threads: usize, steps: usize, world: impl FnOnce() -> World + Send) -> World {
