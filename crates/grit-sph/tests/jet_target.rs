@@ -4,10 +4,10 @@
 
 mod common;
 
-use common::{flow_bits, lattice, stepped_on};
+use common::{copper_under_water, flow_bits, stepped_on};
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
-use grit_sph::{Abrasives, Fluid, Material, PenaltyParams, Settings, Vector, World};
+use grit_sph::{Abrasives, PenaltyParams, Settings, Vector, World};
 
 const DX: f64 = 1e-4;
 
@@ -26,22 +26,7 @@ fn no_grains() -> Dem {
 /// down onto it at `speed`, and, with `grains`, garnet grains in the water coupled to it.
 fn water_on_copper(speed: f64, grains: bool) -> World {
     let mut w = World::new(Settings::water_jet(DX, Vector::zeros())).unwrap();
-    let target = lattice(DX, 20, 8, Vector::new(0.0, -8.0 * DX));
-    let vols = vec![DX * DX; target.len()];
-    w.add_deformable(
-        "target",
-        Material::copper(),
-        &target,
-        &vols,
-        Vector::zeros(),
-    )
-    .unwrap();
-    let water = lattice(DX, 12, 8, Vector::new(4.0 * DX, 0.0));
-    let (vols, pres) = (vec![DX * DX; water.len()], vec![0.0; water.len()]);
-    let v = Vector::new(0.0, -speed);
-    let b = w
-        .add_fluid("water", Fluid::water(), &water, &vols, &pres, v)
-        .unwrap();
+    let b = copper_under_water(&mut w, DX, 8, Vector::new(0.0, -speed));
     if grains {
         let dem = no_grains();
         w.set_abrasives(Abrasives::new(

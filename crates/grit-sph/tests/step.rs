@@ -5,15 +5,15 @@
 
 mod common;
 
-use common::lattice;
+use common::copper_under_water;
 use grit_sph::coupling::CouplingParams;
 use grit_sph::dem::{Dem, DemParams, Grain};
 use grit_sph::particles::{ParticlesState, PARTICLES_STATE_VERSION};
 use grit_sph::verification::elastic_impact;
 use grit_sph::world::WORLD_STATE_VERSION;
 use grit_sph::{
-    Abrasives, Fluid, InputError, Material, Nozzle, Particles, PenaltyParams, Settings, Stage,
-    Timers, Vector, World, WorldState,
+    Abrasives, InputError, Nozzle, Particles, PenaltyParams, Settings, Stage, Timers, Vector,
+    World, WorldState,
 };
 use serde_json::Value;
 
@@ -23,28 +23,7 @@ const DX: f64 = 1e-4;
 /// water falling onto it from a nozzle, an outflow, and two garnet grains coupled to the water.
 fn jet_on_copper() -> World {
     let mut w = World::new(Settings::water_jet(DX, Vector::new(0.0, -9.81))).unwrap();
-    let target = lattice(DX, 20, 8, Vector::new(0.0, -8.0 * DX));
-    let vols = vec![DX * DX; target.len()];
-    w.add_deformable(
-        "target",
-        Material::copper(),
-        &target,
-        &vols,
-        Vector::zeros(),
-    )
-    .unwrap();
-    let water = lattice(DX, 12, 4, Vector::new(4.0 * DX, 0.0));
-    let (vols, pres) = (vec![DX * DX; water.len()], vec![0.0; water.len()]);
-    let b = w
-        .add_fluid(
-            "water",
-            Fluid::water(),
-            &water,
-            &vols,
-            &pres,
-            Vector::new(0.0, -100.0),
-        )
-        .unwrap();
+    let b = copper_under_water(&mut w, DX, 4, Vector::new(0.0, -100.0));
     w.add_inflow(
         b,
         Nozzle {

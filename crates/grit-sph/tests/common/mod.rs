@@ -3,7 +3,7 @@
 //! a lattice of particle positions. Each test file uses some of them.
 #![allow(dead_code)]
 
-use grit_sph::{Vector, World};
+use grit_sph::{Fluid, Material, Vector, World};
 
 /// Cell centres of an `nx` × `ny` lattice of spacing `dx` whose lower left corner is `origin`.
 pub fn lattice(dx: f64, nx: usize, ny: usize, origin: Vector) -> Vec<Vector> {
@@ -42,4 +42,23 @@ pub fn flow_bits(w: &World) -> Vec<u64> {
         .chain(p.rho.iter().chain(&p.energy).map(|r| r.to_bits()))
         .chain([w.dt().to_bits()])
         .collect()
+}
+
+/// A 20 × 8 copper block below the surface line y = 0 and a 12-wide block of `rows` rows of
+/// water on it, moving at `vel`, on a lattice of spacing `dx`; returns the water's body.
+pub fn copper_under_water(w: &mut World, dx: f64, rows: usize, vel: Vector) -> usize {
+    let target = lattice(dx, 20, 8, Vector::new(0.0, -8.0 * dx));
+    let vols = vec![dx * dx; target.len()];
+    w.add_deformable(
+        "target",
+        Material::copper(),
+        &target,
+        &vols,
+        Vector::zeros(),
+    )
+    .unwrap();
+    let water = lattice(dx, 12, rows, Vector::new(4.0 * dx, 0.0));
+    let (vols, pres) = (vec![dx * dx; water.len()], vec![0.0; water.len()]);
+    w.add_fluid("water", Fluid::water(), &water, &vols, &pres, vel)
+        .unwrap()
 }
