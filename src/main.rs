@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use cli::{bench, campaign, jet, plot, sample, serve, study};
+use cli::{bench, campaign, jet, plot, sample, serve, study, version};
 
 /// Solid particle erosion predicted by SPH impact simulations.
 #[derive(Parser)]
@@ -92,6 +92,10 @@ enum Command {
     /// stability map, and the coordinator's load test.
     #[command(after_help = "Example: grit bench impact --spacing-m 1.5625e-5 --repeat 3")]
     Bench(bench::BenchArgs),
+    /// Print the version, the commit and the engine fingerprints: hashes of the bits a short
+    /// canonical impact and jet leave, equal on every machine that computes the same numbers.
+    #[command(after_help = "Example: grit version --json")]
+    Version(version::Args),
 }
 
 fn main() -> ExitCode {
@@ -108,6 +112,7 @@ fn main() -> ExitCode {
         Command::Plot(a) => plot::run(a),
         Command::Compare(a) => plot::compare(a),
         Command::Bench(a) => bench::run(a),
+        Command::Version(a) => version::run(a),
         Command::Serve(a) => farm("info", serve::serve(a)),
         Command::Work(a) => farm("info", serve::work(a)),
         Command::Run(a) => farm("warn", campaign::run(a)),

@@ -11,6 +11,7 @@ pub mod progress;
 pub mod sample;
 pub mod serve;
 pub mod study;
+pub mod version;
 
 use std::path::PathBuf;
 

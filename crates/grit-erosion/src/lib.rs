@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod campaign;
+pub mod fingerprint;
 pub mod models;
 pub mod scene;
 pub mod scenes;

@@ -1,0 +1,168 @@
+//! Engine fingerprints: which bits an engine computes, measured rather than declared. A short
+//! canonical run of each scene (one coarse impact with contact, plasticity and damage; a few
+//! steps of a jet with water, grains and a copper target) is hashed bit for bit, so two builds
+//! that compute the same numbers share a fingerprint whatever their commit, compiler or CPU,
+//! and builds that differ anywhere in those numbers do not (grit's determinism contract,
+//! `docs/design.md`, "Rules the engine keeps").
+
+use grit_sph::{Matrix, Particles, Vector};
+use sha2::{Digest, Sha256};
+
+use crate::impact::ImpactParams;
+use crate::jet::{JetParams, JetRun};
+use crate::models::shapes::Shape;
+use crate::scene::{Scene, SceneError};
+use crate::Sample;
+
+/// Hex digits a fingerprint keeps of its SHA-256: 64 bits, no collision in any farm's life.
+pub const FINGERPRINT_HEX: usize = 16;
+
+/// The impact of the impact fingerprint: seed section 4's scene at 10 particles per Dg on a
+/// 2 × 1.25 Dg surface, a hexagon at 45° and 150 m/s, fast enough to yield and damage the surface
+/// within its few hundred steps.
+pub fn canonical_impact() -> ImpactParams {
+    ImpactParams {
+        spacing_m: 25e-6,
+        surface_width_dg: 2.0,
+        surface_depth_dg: 1.25,
+        distribution_range_dg: 0.0,
+        velocity_m_s: 150.0,
+        ..ImpactParams::paper(45.0, Shape::Hexagon)
+    }
+}
+
+/// The jet of the jet fingerprint: the default copper scene shrunk to a 3 × 1.2 mm target
+/// 1 mm below the nozzle at Δx = 100 µm, for 5 µs: the water and its grains reach and dent the
+/// target within the run.
+pub fn canonical_jet() -> JetParams {
+    JetParams {
+        spacing_m: 1e-4,
+        time_ms: 0.005,
+        slice_ms: 0.005,
+        standoff_m: 1e-3,
+        target_width_m: 3e-3,
+        target_depth_m: 1.2e-3,
+        ..JetParams::default()
+    }
+}
+
+/// Every number of `p` that a step writes, as bits, in particle order.
+fn hash_particles(h: &mut Sha256, p: &Particles) {
+    let v = |h: &mut Sha256, x: &Vector| {
+        h.update(x.x.to_bits().to_le_bytes());
+        h.update(x.y.to_bits().to_le_bytes());
+    };
+    let m = |h: &mut Sha256, a: &Matrix| {
+        for x in a.iter() {
+            h.update(x.to_bits().to_le_bytes());
+        }
+    };
+    h.update((p.len() as u64).to_le_bytes());
+    for i in 0..p.len() {
+        h.update(p.id[i].to_le_bytes());
+        v(h, &p.pos[i]);
+        v(h, &p.vel[i]);
+        for x in [p.mass[i], p.rho[i], p.eps_p[i], p.temp[i], p.damage[i]] {
+            h.update(x.to_bits().to_le_bytes());
+        }
+        m(h, &p.sdev[i]);
+        m(h, &p.def_grad[i]);
+    }
+}
+
+fn hex(h: Sha256) -> String {
+    format!("{:x}", h.finalize())[..FINGERPRINT_HEX].to_string()
+}
+
+/// The impact engine's fingerprint: the bits [`canonical_impact`] leaves in the surface and
+/// its record, hashed (SHA-256, first [`FINGERPRINT_HEX`] hex digits).
+pub fn impact_engine() -> Result<String, SceneError> {
+    impact_engine_of(&canonical_impact())
+}
+
+/// [`impact_engine`]'s hash of the first impact of `params` seeded 1.
+pub fn impact_engine_of(params: &ImpactParams) -> Result<String, SceneError> {
+    let mut s = Sample::start(params, 1)?;
+    let rec = Scene::run_next(&mut s, &|| false)?
+        .ok_or_else(|| SceneError::Run("the canonical impact was cancelled".into()))?;
+    let mut h = Sha256::new();
+    hash_particles(&mut h, s.surface());
+    for x in [rec.mass_loss_kg, rec.orientation_rad, rec.aim_x_m] {
+        h.update(x.to_bits().to_le_bytes());
+    }
+    Ok(hex(h))
+}
+
+/// The jet engine's fingerprint: the bits [`canonical_jet`] leaves in its world and crater
+/// samples, hashed as [`impact_engine`]'s.
+pub fn jet_engine() -> Result<String, SceneError> {
+    let mut run = JetRun::start(&canonical_jet(), 1)?;
+    let mut h = Sha256::new();
+    while run.units_done() < run.slices_total() {
+        let slice = Scene::run_next(&mut run, &|| false)?
+            .ok_or_else(|| SceneError::Run("the canonical jet was cancelled".into()))?;
+        let c = &slice.sample;
+        for x in [
+            c.t_s,
+            c.mass_loss_kg_m,
+            c.crater_depth_m,
+            c.crater_width_m,
+            c.max_plastic_strain,
+        ] {
+            h.update(x.to_bits().to_le_bytes());
+        }
+    }
+    hash_particles(&mut h, run.world().particles());
+    Ok(hex(h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_canonical_impact_yields_and_damages_the_surface() {
+        let mut s = Sample::start(&canonical_impact(), 1).unwrap();
+        s.run_next().unwrap();
+        let p = s.surface();
+        assert!(p.eps_p.iter().any(|&e| e > 0.0), "no plastic strain");
+        assert!(p.damage.iter().any(|&d| d > 0.0), "no damage");
+    }
+
+    #[test]
+    fn the_canonical_jet_dents_the_target() {
+        let mut run = JetRun::start(&canonical_jet(), 1).unwrap();
+        let slice = Scene::run_next(&mut run, &|| false).unwrap().unwrap();
+        assert!(slice.sample.max_plastic_strain > 0.0, "{:?}", slice.sample);
+        assert!(slice.grain_hits.is_some(), "no grain touched the target");
+    }
+
+    #[test]
+    fn fingerprints_are_the_same_on_one_and_two_threads() {
+        let on = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| (impact_engine().unwrap(), jet_engine().unwrap()))
+        };
+        let one = on(1);
+        assert_eq!(one, on(2));
+        assert_eq!(
+            (one.0.len(), one.1.len()),
+            (FINGERPRINT_HEX, FINGERPRINT_HEX)
+        );
+    }
+
+    #[test]
+    fn a_one_ulp_change_of_one_constant_moves_the_fingerprint() {
+        let base = canonical_impact();
+        let mut moved = base.clone();
+        let youngs = &mut moved.material.youngs_modulus_pa;
+        *youngs = f64::from_bits(youngs.to_bits() + 1);
+        assert_ne!(
+            impact_engine_of(&base).unwrap(),
+            impact_engine_of(&moved).unwrap()
+        );
+    }
+}
