@@ -150,6 +150,42 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+async fn one_worker_process_holds_two_jobs_at_once() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    // Ten impacts a sample: both loops claim within milliseconds of starting, long before
+    // either could finish its first job and take the other's.
+    let spec = campaign(2, 10);
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&spec, None).await.unwrap().id;
+    let w = start_worker(dir.path(), &coord.url, "w", &["--jobs", "2"]);
+    let s = wait_done(&c, id, Duration::from_secs(120)).await;
+    assert_eq!(s.impacts_done, 20);
+    // Each job was run by its own loop of the one process, on its own lease.
+    let jobs: Value = reqwest::Client::new()
+        .get(format!("{}/api/v1/campaigns/{id}/jobs", coord.url))
+        .bearer_auth(SUBMIT)
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    let mut names: Vec<&str> = jobs
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j["worker"].as_str().unwrap_or(""))
+        .collect();
+    names.sort();
+    assert_eq!(names, ["w/1", "w/2"], "{jobs}");
+    assert!(w.log_text().contains("jobs=2"), "{}", w.log_text());
+    let farm = c.results_value(id, false).await.unwrap();
+    assert_eq!(farm, grit_run(dir.path(), &spec, "local", false));
+}
+
+#[tokio::test(flavor = "multi_thread")]
 async fn killed_worker_is_resumed_from_checkpoint_bit_for_bit() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();

@@ -66,9 +66,15 @@ pub struct ServeArgs {
 pub struct WorkArgs {
     #[command(flatten)]
     pub remote: Remote,
-    /// Engine threads (rayon pool size); default all cores.
+    /// Engine threads (rayon pool size) of each job; default all cores with one job, one
+    /// thread each with several.
     #[arg(long, env = "GRIT_THREADS", value_parser = crate::cli::thread_count)]
     pub threads: Option<usize>,
+    /// Jobs this process holds at once, each on its own lease and engine pool, so one process
+    /// serves all of a machine's cores (a farm's throughput is one job per core:
+    /// docs/performance.md); reported to the coordinator as NAME/1 … NAME/N.
+    #[arg(long, default_value_t = 1, env = "GRIT_JOBS", value_parser = crate::cli::thread_count)]
+    pub jobs: usize,
     /// Upload a checkpoint every this many impacts.
     #[arg(long, default_value_t = 5, value_parser = crate::cli::at_least_one)]
     pub checkpoint_every: u32,
@@ -145,22 +151,48 @@ pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
         token,
         Duration::from_secs_f64(a.request_timeout_s),
     )?;
-    let opts = WorkerOptions {
-        name: a.name.unwrap_or_else(worker::default_name),
-        threads: a.threads,
-        checkpoint_every: a.checkpoint_every,
-        exit_when_idle: a.exit_when_idle,
-        idle_poll: Duration::from_secs_f64(a.poll_s),
-        ..WorkerOptions::default()
-    };
+    let name = a.name.unwrap_or_else(worker::default_name);
+    // With several jobs each gets one engine thread unless told otherwise: samples are
+    // independent and parallelise better than the threads inside one impact.
+    let threads = a.threads.or((a.jobs > 1).then_some(1));
     let stop = Stop::default();
     on_signals(stop.clone());
-    tracing::info!(coordinator = %client.base(), name = %opts.name, "worker started");
-    let summary = worker::run(client, opts, stop).await?;
-    tracing::info!(
-        jobs = summary.jobs_done,
-        units = summary.units,
-        "worker stopped"
-    );
+    tracing::info!(coordinator = %client.base(), %name, jobs = a.jobs, "worker started");
+    let loops: Vec<_> = (1..=a.jobs)
+        .map(|k| {
+            let opts = WorkerOptions {
+                name: if a.jobs > 1 {
+                    format!("{name}/{k}")
+                } else {
+                    name.clone()
+                },
+                threads,
+                checkpoint_every: a.checkpoint_every,
+                exit_when_idle: a.exit_when_idle,
+                idle_poll: Duration::from_secs_f64(a.poll_s),
+                ..WorkerOptions::default()
+            };
+            tokio::spawn(worker::run(client.clone(), opts, stop.clone()))
+        })
+        .collect();
+    let (mut jobs, mut units) = (0, 0);
+    let mut failed = None;
+    for l in loops {
+        match l.await.context("worker loop panicked")? {
+            Ok(s) => {
+                jobs += s.jobs_done;
+                units += s.units;
+            }
+            Err(e) => {
+                // One loop refused (a bad token): stop the others too.
+                stop.trigger();
+                failed.get_or_insert(e);
+            }
+        }
+    }
+    tracing::info!(jobs, units, "worker stopped");
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
     Ok(ExitCode::SUCCESS)
 }
