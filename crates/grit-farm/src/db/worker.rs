@@ -103,56 +103,24 @@ impl Leased {
     }
 }
 
-/// An impact record to store, serialised before it is queued so the writer only binds it.
-pub(super) struct NewImpact {
-    impact: u32,
-    grain_mass_kg: f64,
-    mass_loss_kg: f64,
-    /// The record, for its scene's checks.
-    record: ImpactRecord,
+/// A record to store (an impact, a jet slice), serialised before it is queued so the writer
+/// only binds it.
+pub(super) struct NewRecord<R> {
+    /// The record, for its scene's checks and its columns.
+    record: R,
     /// The whole record as JSON, with round-trip float formatting (every f64 comes back
-    /// bit for bit).
+    /// bit for bit; a slice's profile included).
     json: String,
 }
 
-/// `impacts` ready to store.
-fn serialised(impacts: &[ImpactRecord]) -> Result<Vec<NewImpact>> {
-    impacts
+/// `records` ready to store.
+fn serialised<R: serde::Serialize + Clone>(records: &[R]) -> Result<Vec<NewRecord<R>>> {
+    records
         .iter()
         .map(|rec| {
-            Ok(NewImpact {
-                impact: rec.impact,
-                grain_mass_kg: rec.grain_mass_kg,
-                mass_loss_kg: rec.mass_loss_kg,
+            Ok(NewRecord {
                 record: rec.clone(),
                 json: serde_json::to_string(rec).map_err(|e| Error::Internal(e.to_string()))?,
-            })
-        })
-        .collect()
-}
-
-/// A jet slice to store, serialised before it is queued (its profile included).
-pub(super) struct NewSlice {
-    slice: u32,
-    t_s: f64,
-    mass_loss_kg_m: f64,
-    /// The record, for its scene's checks.
-    record: JetSlice,
-    /// The whole `JetSlice` as JSON, with round-trip float formatting.
-    json: String,
-}
-
-/// `slices` ready to store.
-fn serialised_slices(slices: &[JetSlice]) -> Result<Vec<NewSlice>> {
-    slices
-        .iter()
-        .map(|s| {
-            Ok(NewSlice {
-                slice: s.slice,
-                t_s: s.sample.t_s,
-                mass_loss_kg_m: s.sample.mass_loss_kg_m,
-                record: s.clone(),
-                json: serde_json::to_string(s).map_err(|e| Error::Internal(e.to_string()))?,
             })
         })
         .collect()
@@ -188,15 +156,15 @@ impl<'a> Reported<'a> {
 
 /// A report ready to store: records serialised before the writer sees them.
 pub(super) struct NewUnits {
-    pub impacts: Vec<NewImpact>,
-    pub slices: Vec<NewSlice>,
+    pub impacts: Vec<NewRecord<ImpactRecord>>,
+    pub slices: Vec<NewRecord<JetSlice>>,
 }
 
 impl NewUnits {
     fn of(r: Reported<'_>) -> Result<NewUnits> {
         Ok(NewUnits {
             impacts: serialised(r.impacts)?,
-            slices: serialised_slices(r.slices)?,
+            slices: serialised(r.slices)?,
         })
     }
 }
@@ -760,7 +728,7 @@ async fn store_impacts(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     held: &Held,
-    impacts: &[NewImpact],
+    impacts: &[NewRecord<ImpactRecord>],
     now: i64,
 ) -> Result<u32> {
     let mut done = held.done;
@@ -770,7 +738,13 @@ async fn store_impacts(
     let mut lost: Option<f64> = None;
     for (i, rec) in impacts.iter().enumerate() {
         let field = |name: &str| format!("impacts[{i}].{name}");
-        if !is_next("impact", rec.impact, done, held.planned, field("impact"))? {
+        if !is_next(
+            "impact",
+            rec.record.impact,
+            done,
+            held.planned,
+            field("impact"),
+        )? {
             continue;
         }
         let p = match &scene {
@@ -786,7 +760,7 @@ async fn store_impacts(
                 .map_err(|e| Error::invalid(field(&e.field), e.rule))?,
         );
         new.push(rec);
-        done = rec.impact;
+        done = rec.record.impact;
     }
     for chunk in new.chunks(IMPACT_ROWS_PER_INSERT) {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
@@ -794,9 +768,9 @@ async fn store_impacts(
         );
         qb.push_values(chunk, |mut b, rec| {
             b.push_bind(job_id)
-                .push_bind(rec.impact as i64)
-                .push_bind(rec.grain_mass_kg)
-                .push_bind(rec.mass_loss_kg)
+                .push_bind(rec.record.impact as i64)
+                .push_bind(rec.record.grain_mass_kg)
+                .push_bind(rec.record.mass_loss_kg)
                 .push_bind(rec.json.as_str())
                 .push_bind(now);
         });
@@ -812,7 +786,7 @@ async fn store_slices(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     held: &Held,
-    slices: &[NewSlice],
+    slices: &[NewRecord<JetSlice>],
     now: i64,
 ) -> Result<u32> {
     let mut done = held.done;
@@ -820,7 +794,13 @@ async fn store_slices(
     let mut scene = None;
     for (i, rec) in slices.iter().enumerate() {
         let field = |name: &str| format!("slices[{i}].{name}");
-        if !is_next("slice", rec.slice, done, held.planned, field("slice"))? {
+        if !is_next(
+            "slice",
+            rec.record.slice,
+            done,
+            held.planned,
+            field("slice"),
+        )? {
             continue;
         }
         let p = match &scene {
@@ -830,7 +810,7 @@ async fn store_slices(
         JetRun::check_record(p, &rec.record, 0.0)
             .map_err(|e| Error::invalid(field(&e.field), e.rule))?;
         new.push(rec);
-        done = rec.slice;
+        done = rec.record.slice;
     }
     for chunk in new.chunks(IMPACT_ROWS_PER_INSERT) {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
@@ -838,9 +818,9 @@ async fn store_slices(
         );
         qb.push_values(chunk, |mut b, rec| {
             b.push_bind(job_id)
-                .push_bind(rec.slice as i64)
-                .push_bind(rec.t_s)
-                .push_bind(rec.mass_loss_kg_m)
+                .push_bind(rec.record.slice as i64)
+                .push_bind(rec.record.sample.t_s)
+                .push_bind(rec.record.sample.mass_loss_kg_m)
                 .push_bind(rec.json.as_str())
                 .push_bind(now);
         });
