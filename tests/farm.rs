@@ -268,7 +268,7 @@ async fn stale_worker_gets_409_and_changes_nothing() {
     let stale = worker_client(&coord.url);
     let job = stale.claim("stale").await.unwrap().expect("a job");
     // A real impact, slower than the 1 s lease.
-    let params = job.params.clone();
+    let params: grit_erosion::ImpactParams = serde_json::from_value(job.params.clone()).unwrap();
     let seed = job.seed;
     let record = tokio::task::spawn_blocking(move || {
         let mut s = grit_erosion::Sample::new(params, seed).unwrap();

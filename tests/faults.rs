@@ -356,7 +356,8 @@ async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed
     assert_ne!(a.job_id, b.job_id);
 
     // Job a's first two impacts, run here; the first is reported with its checkpoint.
-    let (params, seed) = (a.params.clone(), a.seed);
+    let params: grit_erosion::ImpactParams = serde_json::from_value(a.params.clone()).unwrap();
+    let seed = a.seed;
     let (one, two) = tokio::task::spawn_blocking(move || {
         let mut s = Sample::new(params, seed).unwrap();
         s.run_next().unwrap();
@@ -379,7 +380,8 @@ async fn corrupt_checkpoint_uploads_are_refused_and_the_last_good_one_is_resumed
     let half = &bytes[..bytes.len() / 2];
     let mut flipped = bytes.clone();
     flipped[bytes.len() / 2] ^= 0x10;
-    let b_bytes = Sample::new(b.params.clone(), b.seed).unwrap().checkpoint();
+    let b_params = serde_json::from_value(b.params.clone()).unwrap();
+    let b_bytes = Sample::new(b_params, b.seed).unwrap().checkpoint();
     let uploads = [
         (
             "cut short in transit",

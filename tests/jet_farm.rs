@@ -15,7 +15,7 @@ use serde_json::Value;
 use uuid::Uuid;
 
 mod common;
-use common::results::grit_run;
+use common::results::{grit_run, raw_slices};
 use common::{start_coordinator, start_worker, wait_for, Api, GRIT, SERIAL, SUBMIT};
 
 /// The lead's tiny scene (crates/grit-erosion/tests/jet.rs): 6 particles across a 0.6 mm jet
@@ -52,25 +52,6 @@ async fn wait_done(c: &Client, id: Uuid) -> CampaignStatus {
     .await;
     assert_eq!(s.state, CampaignState::Done, "{s:?}");
     s
-}
-
-/// Every sample's slices of a results document with `raw`: (cell, sample, slices), each
-/// slice's wall-clock seconds zeroed (the one field that is not a result).
-fn raw_slices(results: &Value) -> Vec<(u64, u64, Vec<JetSlice>)> {
-    results["raw"]
-        .as_array()
-        .expect("raw slices present")
-        .iter()
-        .map(|s| {
-            let mut slices: Vec<JetSlice> = serde_json::from_value(s["slices"].clone()).unwrap();
-            slices.iter_mut().for_each(|x| x.wall_s = 0.0);
-            (
-                s["cell"].as_u64().unwrap(),
-                s["sample"].as_u64().unwrap(),
-                slices,
-            )
-        })
-        .collect()
 }
 
 /// Bit-for-bit equality of two sets of slices (serde_json writes every f64 so it reads back

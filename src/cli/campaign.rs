@@ -464,9 +464,9 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
         ));
         while cells.len() < s.cells.len() {
             let c = &s.cells[cells.len()];
-            let prefix = match s.scene {
-                Scene::Impact => format!("{:.1}° {}", c.angle_deg, c.shape),
-                Scene::Jet => format!("jet cell {} ({})", c.cell, unit(s.scene)),
+            let prefix = match (c.angle_deg, &c.shape) {
+                (Some(angle), Some(shape)) => format!("{angle:.1}° {shape}"),
+                _ => format!("{} cell {} ({})", s.scene.as_str(), c.cell, unit(s.scene)),
             };
             cells.push(multi.add(progress::bar(c.impacts_total, &prefix, true)));
         }

@@ -1,9 +1,10 @@
 //! Results the process-level tests compare: `grit run`'s results.json, the per-impact raw
-//! series of a results document, and their bit-for-bit equality.
+//! series (or jet slices) of a results document, and their bit-for-bit equality.
 
 use std::path::Path;
 use std::process::Command;
 
+use grit_erosion::jet::JetSlice;
 use grit_erosion::ImpactRecord;
 use serde_json::Value;
 
@@ -69,4 +70,23 @@ pub fn grit_run(dir: &Path, spec: &str, out: &str, raw: bool) -> Value {
     let status = cmd.status().expect("grit run starts");
     assert!(status.success(), "grit run failed");
     serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap()
+}
+
+/// Every sample's slices of a results document with `raw`: (cell, sample, slices), each
+/// slice's wall-clock seconds zeroed (the one field that is not a result).
+pub fn raw_slices(results: &Value) -> Vec<(u64, u64, Vec<JetSlice>)> {
+    results["raw"]
+        .as_array()
+        .expect("raw slices present")
+        .iter()
+        .map(|s| {
+            let mut slices: Vec<JetSlice> = serde_json::from_value(s["slices"].clone()).unwrap();
+            slices.iter_mut().for_each(|x| x.wall_s = 0.0);
+            (
+                s["cell"].as_u64().unwrap(),
+                s["sample"].as_u64().unwrap(),
+                slices,
+            )
+        })
+        .collect()
 }

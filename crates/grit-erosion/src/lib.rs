@@ -28,5 +28,5 @@ pub use models::oka::{
     ShapeReference, AISI304_HV_GPA,
 };
 pub use models::shapes::{Shape, ShapeError, ShapeInfo};
-pub use scene::{Scene, SceneError};
+pub use scene::{Scene, SceneError, SceneSet, SceneVisitor, Scenes};
 pub use stats::{AggregateError, SlopeFit};

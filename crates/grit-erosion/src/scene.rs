@@ -11,7 +11,7 @@ use serde::Serialize;
 
 /// One job's simulation, run one unit at a time (seed paper section 4: a sample's impacts;
 /// the AWJ paper: a jet's time slices).
-pub trait Scene: Sized + Send + 'static {
+pub trait Scene: Sized + Send + Sync + 'static {
     /// The name a campaign of this scene is stored under (`impact`, `jet`).
     const KIND: &'static str;
     /// The unit, in words, for logs and errors (`impact`, `slice`).
@@ -50,6 +50,45 @@ pub trait Scene: Sized + Send + 'static {
         record: &Self::Record,
         lost_before_kg_m: f64,
     ) -> Result<f64, InputError>;
+}
+
+/// Something done with a scene picked at run time by its [`Scene::KIND`], as the farm does
+/// with a stored job: the farm's code is generic over [`Scene`] and never names a scene.
+pub trait SceneVisitor {
+    /// What the visit gives.
+    type Output;
+    /// Does it with scene `S`.
+    fn visit<S: Scene>(self) -> Self::Output;
+}
+
+/// Which scenes a farm runs, by kind: grit's own ([`Scenes`]), or those and more.
+pub trait SceneSet: Send + Sync + 'static {
+    /// The kinds the set holds.
+    fn kinds() -> &'static [&'static str];
+    /// Runs `v` with the scene stored as `kind`; `None` for a kind the set does not hold.
+    fn visit<V: SceneVisitor>(kind: &str, v: V) -> Option<V::Output>;
+}
+
+/// grit's scenes: single-grain impacts (`impact`) and the abrasive water jet (`jet`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Scenes;
+
+impl SceneSet for Scenes {
+    fn kinds() -> &'static [&'static str] {
+        use crate::{jet::JetRun, Sample};
+        &[Sample::KIND, JetRun::KIND]
+    }
+
+    fn visit<V: SceneVisitor>(kind: &str, v: V) -> Option<V::Output> {
+        use crate::{jet::JetRun, Sample};
+        if kind == Sample::KIND {
+            Some(v.visit::<Sample>())
+        } else if kind == JetRun::KIND {
+            Some(v.visit::<JetRun>())
+        } else {
+            None
+        }
+    }
 }
 
 /// Why a scene could not start, resume or run a unit.

@@ -4,9 +4,8 @@
 use std::collections::BTreeMap;
 
 use grit_erosion::campaign::Scene;
-use grit_erosion::jet::JetParams;
-use grit_erosion::{CampaignResults, ImpactParams, ImpactRecord};
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use grit_erosion::{CampaignResults, ImpactRecord};
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 use uuid::Uuid;
@@ -97,10 +96,12 @@ pub struct JobCounts {
 pub struct CellProgress {
     /// Cell index.
     pub cell: u32,
-    /// Impact angle, degrees.
-    pub angle_deg: f64,
-    /// Grain shape name.
-    pub shape: String,
+    /// Impact angle of an impact cell, degrees; absent for a scene without one (the jet).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    /// Grain shape of an impact cell; absent for a scene without one (the jet).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<String>,
     /// Other swept values of the cell.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub swept: BTreeMap<String, f64>,
@@ -244,10 +245,12 @@ pub struct HeldJob {
     pub campaign_name: Option<String>,
     /// Cell index.
     pub cell: u32,
-    /// Impact angle of the cell, degrees.
-    pub angle_deg: f64,
-    /// Grain shape of the cell.
-    pub shape: String,
+    /// Impact angle of an impact cell, degrees; absent for a scene without one (the jet).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    /// Grain shape of an impact cell; absent for a scene without one (the jet).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<String>,
     /// Sample index within the cell.
     pub sample: u32,
     /// Impacts stored.
@@ -346,10 +349,9 @@ pub struct Checkpoint {
     pub data_b64: String,
 }
 
-/// A leased job: everything a worker needs to run (or resume) it. A jet job carries its run
-/// in `jet` and `params: null` on the wire (so a worker that knows no jets refuses the answer
-/// instead of running an impact); its counts are slices.
-#[derive(Debug, Clone, Deserialize, ToSchema)]
+/// A leased job: everything a worker needs to run (or resume) it, whatever its scene: the
+/// scene's kind, its parameters as JSON, and counts in its units (impacts, slices).
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 pub struct ClaimedJob {
     /// Job id.
     pub job_id: i64,
@@ -369,14 +371,12 @@ pub struct ClaimedJob {
     pub impacts_planned: u32,
     /// Impacts already stored by earlier attempts (slices, for a jet job).
     pub impacts_done: u32,
-    /// The impact scene; for a jet job `null` on the wire and the default scene here, unused.
-    #[schema(value_type = Option<Object>)]
-    #[serde(deserialize_with = "null_as_default")]
-    pub params: ImpactParams,
-    /// The jet run, for a jet job.
-    #[serde(default)]
-    #[schema(value_type = Option<Object>)]
-    pub jet: Option<JetParams>,
+    /// The job's scene, by kind (`impact`, `jet`): how to read `params` and what to run.
+    #[serde(default = "impact_kind")]
+    pub scene: String,
+    /// The scene's parameters (`ImpactParams` for `impact`, `JetParams` for `jet`).
+    #[schema(value_type = Object)]
+    pub params: Value,
     /// Whether the job's cell may later ask for more impacts (`until_steady`): then send a
     /// checkpoint after the last impact with `complete`, so the job can resume from it.
     #[serde(default)]
@@ -385,51 +385,9 @@ pub struct ClaimedJob {
     pub checkpoint: Option<Checkpoint>,
 }
 
-/// `null` as the type's default, any other value as itself.
-fn null_as_default<'de, D: Deserializer<'de>, T: Deserialize<'de> + Default>(
-    d: D,
-) -> Result<T, D::Error> {
-    Ok(Option::<T>::deserialize(d)?.unwrap_or_default())
-}
-
-impl Serialize for ClaimedJob {
-    /// The derived form, with `params: null` and `jet` for a jet job (`jet` left out for an
-    /// impact job, whose answer is as before jets).
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        #[derive(Serialize)]
-        struct Wire<'a> {
-            job_id: i64,
-            lease_id: Uuid,
-            lease_ttl_s: f64,
-            campaign_id: Uuid,
-            cell: u32,
-            sample: u32,
-            seed: u64,
-            impacts_planned: u32,
-            impacts_done: u32,
-            params: Option<&'a ImpactParams>,
-            #[serde(skip_serializing_if = "Option::is_none")]
-            jet: Option<&'a JetParams>,
-            extendable: bool,
-            checkpoint: &'a Option<Checkpoint>,
-        }
-        Wire {
-            job_id: self.job_id,
-            lease_id: self.lease_id,
-            lease_ttl_s: self.lease_ttl_s,
-            campaign_id: self.campaign_id,
-            cell: self.cell,
-            sample: self.sample,
-            seed: self.seed,
-            impacts_planned: self.impacts_planned,
-            impacts_done: self.impacts_done,
-            params: self.jet.is_none().then_some(&self.params),
-            jet: self.jet.as_ref(),
-            extendable: self.extendable,
-            checkpoint: &self.checkpoint,
-        }
-        .serialize(s)
-    }
+/// The scene of a claim from a coordinator that did not name it: impacts were its only one.
+fn impact_kind() -> String {
+    "impact".into()
 }
 
 /// Heartbeat: renews the lease and delivers finished units (impacts of an impact job, slices

@@ -5,8 +5,7 @@
 //! again from its first unit.
 
 use base64::Engine;
-use grit_erosion::jet::{JetParams, JetRun};
-use grit_erosion::{ImpactParams, Sample, Scene, SceneError};
+use grit_erosion::{Scene, SceneError};
 use sha2::{Digest, Sha256};
 
 use crate::api::Checkpoint;
@@ -125,29 +124,6 @@ pub fn verify_upload<S: Scene>(
     Ok((run, bytes))
 }
 
-/// The scene a job's checkpoints must hold.
-#[derive(Debug, Clone, PartialEq)]
-pub enum JobParams {
-    /// An impact job's scene.
-    Impact(ImpactParams),
-    /// A jet job's run.
-    Jet(JetParams),
-}
-
-/// [`verify_upload`] of the job's scene, handing back only the checked bytes: what the
-/// coordinator keeps of an upload.
-pub fn verify_any_upload(
-    c: &Checkpoint,
-    job_id: i64,
-    params: &JobParams,
-    seed: u64,
-) -> Result<CheckpointBytes, CheckpointError> {
-    match params {
-        JobParams::Impact(p) => verify_upload::<Sample>(c, job_id, p, seed).map(|(_, b)| b),
-        JobParams::Jet(p) => verify_upload::<JetRun>(c, job_id, p, seed).map(|(_, b)| b),
-    }
-}
-
 /// The envelope checks every checkpoint passes, in order: it names job `job_id`, `data_b64`
 /// is base64 of exactly `size_bytes` bytes, and they hash to `sha256`. Returns the bytes and
 /// their SHA-256.
@@ -211,6 +187,8 @@ mod tests {
     //! naming it; an intact envelope resumes the very sample it was taken of.
 
     use super::*;
+    use grit_erosion::jet::{JetParams, JetRun};
+    use grit_erosion::{ImpactParams, Sample};
 
     /// A scene coarse enough that a fresh surface is built in milliseconds.
     fn coarse() -> ImpactParams {
@@ -276,7 +254,10 @@ mod tests {
         let c = Checkpoint::of(7, &run);
         let back = verify::<JetRun>(&c, 7, &p, 5).unwrap();
         assert_eq!(back.checkpoint(), run.checkpoint());
-        let kept = verify_any_upload(&c, 7, &JobParams::Jet(p.clone()), 5).unwrap();
+        let scenes = crate::scenes::SceneRegistry::default();
+        let jet = scenes.get("jet").unwrap();
+        let p_json = serde_json::to_string(&p).unwrap();
+        let kept = jet.verify_upload(&c, 7, &p_json, 5).unwrap();
         assert_eq!(kept.bytes, run.checkpoint());
         let e = verify::<JetRun>(&c, 7, &p, 6).unwrap_err();
         assert_eq!(e.field, "checkpoint.data_b64");
@@ -293,8 +274,10 @@ mod tests {
         assert_eq!(e.rule, "is 1 but the checkpoint holds 0 slices");
         // An impact checkpoint is no jet checkpoint, and the other way round.
         let (ip, ic, _) = good();
-        assert!(verify_any_upload(&ic, 7, &JobParams::Jet(p), 3).is_err());
-        assert!(verify_any_upload(&c, 7, &JobParams::Impact(ip), 5).is_err());
+        assert!(jet.verify_upload(&ic, 7, &p_json, 3).is_err());
+        let ip_json = serde_json::to_string(&ip).unwrap();
+        let impact = scenes.get("impact").unwrap();
+        assert!(impact.verify_upload(&c, 7, &ip_json, 5).is_err());
     }
 
     #[test]

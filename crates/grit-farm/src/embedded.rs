@@ -146,7 +146,7 @@ pub async fn run(
             });
         }
     }
-    let created = store.create_any(spec, Some(&key)).await?;
+    let created = store.create(spec, Some(&key)).await?;
     if !created.created {
         // Running again continues the campaign. Jobs that failed here mostly lost their lease
         // while the whole process was stopped or the machine slept (its own workers could not

@@ -14,6 +14,7 @@ pub mod db;
 pub mod embedded;
 pub mod error;
 pub mod loadtest;
+pub mod scenes;
 pub mod server;
 pub mod worker;
 

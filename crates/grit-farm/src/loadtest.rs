@@ -210,7 +210,10 @@ async fn client_loop(client: Client, name: String, deadline: Instant) -> Tally {
             continue;
         }
         t.heartbeat_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        let record = placeholder_record(1, job.params.grain_mass_kg_m(), 0.0);
+        // The load test submits impact campaigns only.
+        let grain = serde_json::from_value::<grit_erosion::ImpactParams>(job.params.clone())
+            .map_or(0.0, |p| p.grain_mass_kg_m());
+        let record = placeholder_record(1, grain, 0.0);
         let done = client
             .complete(
                 job.job_id,

@@ -8,8 +8,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use grit_erosion::jet::JetRun;
-use grit_erosion::{Sample, Scene};
+use std::future::Future;
+use std::pin::Pin;
+
+use grit_erosion::{Scene, SceneSet, SceneVisitor, Scenes};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -18,6 +20,28 @@ use crate::api::{
 };
 use crate::checkpoint::verify;
 use crate::client::{Client, ClientError};
+
+/// Runs a claimed job as scene `S`, its parameters read from the claim.
+struct RunJob<'a> {
+    runner: &'a mut Runner,
+    job: ClaimedJob,
+}
+
+impl<'a> SceneVisitor for RunJob<'a> {
+    type Output = Pin<Box<dyn Future<Output = JobEnd> + Send + 'a>>;
+
+    fn visit<S: Scene>(self) -> Self::Output {
+        Box::pin(async move {
+            match serde_json::from_value::<S::Params>(self.job.params.clone()) {
+                Ok(params) => self.runner.run::<S>(self.job, params).await,
+                Err(e) => {
+                    let why = format!("the job's {} parameters do not read: {e}", S::KIND);
+                    self.runner.fail(&self.job, why, vec![]).await
+                }
+            }
+        })
+    }
+}
 
 /// A stop request shared by a signal handler, the async loop and the engine's cancel callback.
 #[derive(Clone)]
@@ -130,9 +154,18 @@ struct Runner {
     summary: WorkerSummary,
 }
 
-/// Runs the worker loop until `stop` is triggered (or the queue is empty with
-/// `exit_when_idle`).
+/// Runs the worker loop for grit's scenes until `stop` is triggered (or the queue is empty
+/// with `exit_when_idle`).
 pub async fn run(
+    client: Client,
+    opts: WorkerOptions,
+    stop: Stop,
+) -> Result<WorkerSummary, WorkerError> {
+    run_scenes::<Scenes>(client, opts, stop).await
+}
+
+/// [`run`] for the scenes of set `Z`: a job of a scene outside it fails, naming the scene.
+pub async fn run_scenes<Z: SceneSet>(
     client: Client,
     opts: WorkerOptions,
     stop: Stop,
@@ -170,7 +203,7 @@ pub async fn run(
                     planned = job.impacts_planned,
                     "job leased"
                 );
-                match r.run_job(job).await {
+                match r.run_job::<Z>(job).await {
                     JobEnd::Done => r.summary.jobs_done += 1,
                     JobEnd::Lost(why) => tracing::warn!(%why, "job dropped"),
                     JobEnd::Failed => {}
@@ -221,14 +254,16 @@ impl Runner {
         S::start(params, job.seed).map_err(|e| e.to_string())
     }
 
-    async fn run_job(&mut self, job: ClaimedJob) -> JobEnd {
-        match job.jet.clone() {
-            Some(params) => self.run::<JetRun>(job, params).await,
-            None => {
-                let params = job.params.clone();
-                self.run::<Sample>(job, params).await
-            }
+    /// Runs `job` as the scene of `Z` its claim names.
+    async fn run_job<Z: SceneSet>(&mut self, job: ClaimedJob) -> JobEnd {
+        let kind = job.scene.clone();
+        if !Z::kinds().contains(&kind.as_str()) {
+            let known = Z::kinds().join(", ");
+            let why = format!("this worker runs the scenes {known}, not {kind:?}");
+            return self.fail(&job, why, vec![]).await;
         }
+        let visit = RunJob { runner: self, job };
+        Z::visit(&kind, visit).expect("the kind is the set's").await
     }
 
     /// Runs job `job` of scene `S` unit by unit (each in a blocking thread, rayon inside the
@@ -467,7 +502,7 @@ mod tests {
     //! changed at rest, so they no longer match the stored checksum) starts the sample again.
 
     use base64::Engine;
-    use grit_erosion::ImpactParams;
+    use grit_erosion::{ImpactParams, Sample};
     use uuid::Uuid;
 
     use super::*;
@@ -483,8 +518,8 @@ mod tests {
             seed: sample.seed(),
             impacts_planned: 3,
             impacts_done: sample.impacts_done(),
-            params: sample.params().clone(),
-            jet: None,
+            scene: "impact".into(),
+            params: serde_json::to_value(sample.params()).unwrap(),
             extendable: false,
             checkpoint,
         }
@@ -504,7 +539,7 @@ mod tests {
         let good = Checkpoint::of(4, &sample);
         let open = |c| {
             let j = job(&sample, c);
-            Runner::open::<Sample>(&j, &j.params)
+            Runner::open::<Sample>(&j, sample.params())
         };
         let resumed = open(Some(good.clone())).unwrap();
         assert_eq!(resumed.impacts_done(), 1);

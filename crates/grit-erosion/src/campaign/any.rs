@@ -2,10 +2,15 @@
 //! ([`super::JetCampaignSpec`]); `"scene": "impact"` or no `scene` key the impact spec
 //! ([`super::CampaignSpec`]), so every spec written before jets existed parses as before.
 
+use std::collections::BTreeMap;
+
 use serde::{Serialize, Serializer};
 use serde_json::Value;
 
-use super::{err, CampaignSpec, JetCampaignSpec, Scene, SpecError};
+use super::{
+    err, job_seed, CampaignSpec, JetCampaignSpec, Scene, SpecError, TargetSem, UntilSteady,
+};
+use crate::Scene as _;
 
 /// A campaign spec of either scene.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,6 +66,106 @@ impl AnySpec {
             AnySpec::Jet(s) => s.validate(),
         }
     }
+}
+
+/// One cell of a campaign as a farm stores it, whatever its scene (seed paper section 4: a
+/// cell is one set of impact conditions, run as independent samples).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedCell {
+    /// Index in the spec's expansion order.
+    pub index: u32,
+    /// An impact cell's angle (degrees); `None` for a scene without one.
+    pub angle_deg: Option<f64>,
+    /// An impact cell's grain shape; `None` for a scene without one.
+    pub shape: Option<String>,
+    /// Values of the other swept dimensions, by name with unit.
+    pub swept: BTreeMap<String, f64>,
+    /// Units (impacts, slices) each sample is first planned for.
+    pub units: u32,
+    /// The scene's parameters of every job of the cell, as JSON.
+    pub params: String,
+    /// The rule growing the units until the cell is steady, if any.
+    pub until_steady: Option<UntilSteady>,
+}
+
+/// A campaign as a farm stores it: its cells and jobs, from one validation of the spec.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CampaignPlan {
+    /// The scene's kind (`grit_erosion::Scene::KIND`).
+    pub kind: &'static str,
+    /// Samples every cell first gets.
+    pub samples: u32,
+    /// The rule growing the samples until the error bar is small, if any.
+    pub target_sem: Option<TargetSem>,
+    /// The cells in expansion order.
+    pub cells: Vec<PlannedCell>,
+    /// Units over every job as first planned.
+    pub units_total: u64,
+    /// Every job as (cell, sample, units planned, seed), cell by cell.
+    pub jobs: Vec<(u32, u32, u32, u64)>,
+}
+
+impl AnySpec {
+    /// The campaign's cells and jobs, validating the spec once.
+    pub fn plan(&self) -> Result<CampaignPlan, SpecError> {
+        let (kind, seed, samples, target_sem, cells) = match self {
+            AnySpec::Impact(s) => (
+                crate::Sample::KIND,
+                s.seed,
+                s.samples.initial(),
+                s.samples.target_sem(),
+                s.cells()?
+                    .into_iter()
+                    .map(|c| PlannedCell {
+                        index: c.index,
+                        angle_deg: Some(c.params.angle_deg),
+                        shape: Some(c.params.shape.name().to_string()),
+                        swept: c.swept,
+                        units: c.impacts,
+                        params: json(&c.params),
+                        until_steady: c.until_steady,
+                    })
+                    .collect::<Vec<_>>(),
+            ),
+            AnySpec::Jet(s) => (
+                crate::jet::JetRun::KIND,
+                s.seed,
+                s.samples,
+                None,
+                s.cells()?
+                    .into_iter()
+                    .map(|c| PlannedCell {
+                        index: c.index,
+                        angle_deg: None,
+                        shape: None,
+                        swept: c.swept,
+                        units: c.slices,
+                        params: json(&c.params),
+                        until_steady: None,
+                    })
+                    .collect(),
+            ),
+        };
+        let jobs: Vec<_> = cells
+            .iter()
+            .flat_map(|c| {
+                (0..samples).map(move |s| (c.index, s, c.units, job_seed(seed, c.index, s)))
+            })
+            .collect();
+        Ok(CampaignPlan {
+            kind,
+            samples,
+            target_sem,
+            units_total: jobs.iter().map(|j| j.2 as u64).sum(),
+            cells,
+            jobs,
+        })
+    }
+}
+
+/// A scene's parameters as the JSON a farm stores, with round-trip floats.
+fn json<T: Serialize>(params: &T) -> String {
+    serde_json::to_string(params).expect("scene parameters are plain data")
 }
 
 impl Serialize for AnySpec {

@@ -26,7 +26,7 @@ pub(crate) mod json;
 mod plan;
 pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts, JobSpec};
 pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, JetJob, Scene};
-pub use any::AnySpec;
+pub use any::{AnySpec, CampaignPlan, PlannedCell};
 pub use plan::{
     annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
 };

@@ -3,14 +3,13 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{AnySpec, CampaignSpec, Scene};
+use grit_erosion::campaign::{AnySpec, CampaignPlan, CampaignSpec, Scene};
 use grit_erosion::{aggregate_campaign, Impact, ImpactRecord, SampleInput};
 use sqlx::Row;
 use uuid::Uuid;
 
 use super::{
-    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, parse_uuid,
-    per_cell_and_sample, NewCampaign, NewJob, Store,
+    by_idempotency_key, insert_campaign, insert_queued_jobs, now_ms, parse_uuid, NewCampaign, Store,
 };
 use crate::api::{
     AnyResults, CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress,
@@ -35,38 +34,38 @@ fn scene_of(r: &sqlx::sqlite::SqliteRow) -> Scene {
 }
 
 impl Store {
-    /// Stores a campaign of either scene ([`Store::create_campaign`],
-    /// [`Store::create_jet_campaign`]).
-    pub async fn create_any(
+    /// Validates, expands and stores a campaign of any scene with all its jobs in one
+    /// transaction. With an idempotency key already used, returns the earlier campaign
+    /// instead.
+    pub async fn create(
         &self,
         spec: &AnySpec,
         idempotency_key: Option<&str>,
     ) -> Result<CampaignCreated> {
-        match spec {
-            AnySpec::Impact(s) => self.create_campaign(s, idempotency_key).await,
-            AnySpec::Jet(s) => self.create_jet_campaign(s, idempotency_key).await,
-        }
+        let plan = spec.plan()?;
+        let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
+        self.create_planned(&plan, &spec_json, spec.name(), idempotency_key)
+            .await
     }
 
-    /// Validates, expands and stores a campaign with all its jobs in one transaction. With an
-    /// idempotency key already used, returns the earlier campaign instead.
-    pub async fn create_campaign(
+    /// Stores campaign `plan` (its spec as `spec_json`, its name `name`) with all its jobs in
+    /// one transaction: [`Store::create`] once the spec is planned, and the way in for a scene
+    /// whose spec grit does not parse.
+    pub async fn create_planned(
         &self,
-        spec: &CampaignSpec,
+        plan: &CampaignPlan,
+        spec_json: &str,
+        name: Option<&str>,
         idempotency_key: Option<&str>,
     ) -> Result<CampaignCreated> {
-        let cells = spec.cells()?;
-        let impacts_total = spec.impacts_total()?;
-        let samples = spec.samples.initial();
-        let target = spec.samples.target_sem();
-        let jobs_total = cells.len() as u64 * samples as u64;
-        let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
+        let jobs_total = plan.jobs.len() as u64;
+        let internal = |e: serde_json::Error| Error::Internal(e.to_string());
         let mut tx = self.begin().await?;
-        if let Some(id) = by_idempotency_key(&mut tx, idempotency_key, &spec_json).await? {
+        if let Some(id) = by_idempotency_key(&mut tx, idempotency_key, spec_json).await? {
             return Ok(CampaignCreated {
                 id,
                 jobs: jobs_total,
-                impacts_total,
+                impacts_total: plan.units_total,
                 created: false,
             });
         }
@@ -76,34 +75,32 @@ impl Store {
             &mut tx,
             NewCampaign {
                 id,
-                scene: Scene::Impact,
-                name: spec.name.as_deref(),
-                spec_json: &spec_json,
-                samples,
-                units_total: impacts_total,
+                scene: plan.kind,
+                name,
+                spec_json,
+                samples: plan.samples,
+                units_total: plan.units_total,
                 max_attempts: self.max_attempts,
                 idempotency_key,
                 now,
             },
         )
         .await?;
-        for cell in &cells {
+        let target = plan.target_sem;
+        for cell in &plan.cells {
             sqlx::query(
-                "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, impacts, params,
-                                    samples, impacts_max, impacts_step, samples_max, target_sem_rel)
+                "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, units, params,
+                                    samples, units_max, units_step, samples_max, target_sem_rel)
                  VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             )
             .bind(id.to_string())
             .bind(cell.index as i64)
-            .bind(cell.params.angle_deg)
-            .bind(cell.params.shape.name())
-            .bind(serde_json::to_string(&cell.swept).map_err(|e| Error::Internal(e.to_string()))?)
-            .bind(cell.impacts as i64)
-            .bind(
-                serde_json::to_string(&cell.params)
-                    .map_err(|e| Error::Internal(e.to_string()))?,
-            )
-            .bind(samples as i64)
+            .bind(cell.angle_deg)
+            .bind(cell.shape.as_deref())
+            .bind(serde_json::to_string(&cell.swept).map_err(internal)?)
+            .bind(cell.units as i64)
+            .bind(cell.params.as_str())
+            .bind(plan.samples as i64)
             .bind(cell.until_steady.map(|u| u.max as i64))
             .bind(cell.until_steady.map(|u| u.step as i64))
             .bind(target.map(|t| t.max as i64))
@@ -111,28 +108,26 @@ impl Store {
             .execute(&mut *tx)
             .await?;
         }
-        let jobs: Vec<NewJob> = cells
-            .iter()
-            .flat_map(|c| {
-                (0..samples).map(move |s| {
-                    (
-                        c.index,
-                        s,
-                        c.impacts,
-                        grit_erosion::campaign::job_seed(spec.seed, c.index, s),
-                    )
-                })
-            })
-            .collect();
-        insert_queued_jobs(&mut tx, &id.to_string(), seq, &jobs, now).await?;
+        insert_queued_jobs(&mut tx, &id.to_string(), seq, &plan.jobs, now).await?;
         tx.commit().await?;
-        tracing::info!(campaign = %id, jobs = jobs_total, impacts_total, "campaign created");
+        tracing::info!(campaign = %id, scene = plan.kind, jobs = jobs_total,
+            units_total = plan.units_total, "campaign created");
         Ok(CampaignCreated {
             id,
             jobs: jobs_total,
-            impacts_total,
+            impacts_total: plan.units_total,
             created: true,
         })
+    }
+
+    /// [`Store::create`] of an impact campaign.
+    pub async fn create_campaign(
+        &self,
+        spec: &CampaignSpec,
+        idempotency_key: Option<&str>,
+    ) -> Result<CampaignCreated> {
+        self.create(&AnySpec::Impact(spec.clone()), idempotency_key)
+            .await
     }
 
     /// Whether a campaign was submitted under `key` (`Idempotency-Key`).
@@ -147,8 +142,8 @@ impl Store {
     /// Every campaign, newest first, with state and progress.
     pub async fn list_campaigns(&self) -> Result<Vec<CampaignSummary>> {
         let rows = sqlx::query(
-            "SELECT c.id, c.name, c.impacts_total, c.created_ms, c.cancelled_ms, c.scene,
-                    COALESCE(SUM(j.impacts_done), 0) AS done,
+            "SELECT c.id, c.name, c.units_total, c.created_ms, c.cancelled_ms, c.scene,
+                    COALESCE(SUM(j.units_done), 0) AS done,
                     COALESCE(SUM(j.state = 'queued'), 0) AS queued,
                     COALESCE(SUM(j.state = 'leased'), 0) AS leased,
                     COALESCE(SUM(j.state = 'done'), 0) AS jobs_done,
@@ -179,7 +174,7 @@ impl Store {
                         impacts_done,
                     ),
                     impacts_done,
-                    impacts_total: r.get::<i64, _>("impacts_total") as u64,
+                    impacts_total: r.get::<i64, _>("units_total") as u64,
                     created_ms: r.get("created_ms"),
                     scene: scene_of(r),
                 })
@@ -218,8 +213,8 @@ impl Store {
         }
         let mut cells = Vec::new();
         for r in sqlx::query(
-            "SELECT k.cell_index, k.angle_deg, k.shape, k.swept, k.impacts, k.samples,
-                    COALESCE(SUM(j.impacts_done), 0) AS done,
+            "SELECT k.cell_index, k.angle_deg, k.shape, k.swept, k.units, k.samples,
+                    COALESCE(SUM(j.units_done), 0) AS done,
                     COALESCE(SUM(j.state = 'done'), 0) AS samples_done
              FROM cells k LEFT JOIN jobs j
                ON j.campaign_id = k.campaign_id AND j.cell_index = k.cell_index
@@ -238,26 +233,18 @@ impl Store {
                 samples_done: r.get::<i64, _>("samples_done") as u64,
                 samples_total: samples,
                 impacts_done: r.get::<i64, _>("done") as u64,
-                impacts_total: r.get::<i64, _>("impacts") as u64 * samples,
+                impacts_total: r.get::<i64, _>("units") as u64 * samples,
             });
         }
         let impacts_done: u64 = cells.iter().map(|c| c.impacts_done).sum();
-        let impacts_total = c.get::<i64, _>("impacts_total") as u64;
+        let impacts_total = c.get::<i64, _>("units_total") as u64;
         let now = now_ms();
         let scene = scene_of(&c);
-        // A jet campaign's rate counts slices.
-        let recent = sqlx::query(match scene {
-            Scene::Impact => {
-                "SELECT COUNT(*) AS n, MIN(i.created_ms) AS first FROM impacts i
-                 JOIN jobs j ON j.id = i.job_id
-                 WHERE j.campaign_id = ? AND i.created_ms > ?"
-            }
-            Scene::Jet => {
-                "SELECT COUNT(*) AS n, MIN(s.created_ms) AS first FROM slices s
-                 JOIN jobs j ON j.id = s.job_id
-                 WHERE j.campaign_id = ? AND s.created_ms > ?"
-            }
-        })
+        let recent = sqlx::query(
+            "SELECT COUNT(*) AS n, MIN(u.created_ms) AS first FROM units u
+             JOIN jobs j ON j.id = u.job_id
+             WHERE j.campaign_id = ? AND u.created_ms > ?",
+        )
         .bind(&ids)
         .bind(now - RATE_WINDOW_MS)
         .fetch_one(&self.read)
@@ -337,21 +324,8 @@ impl Store {
         let spec_text: String = c.get("spec");
         let spec = CampaignSpec::from_json(&spec_text)?;
         let cells = spec.cells()?;
-        let rows = sqlx::query(
-            "SELECT j.cell_index, j.sample_index, i.grain_mass_kg, i.mass_loss_kg
-             FROM impacts i JOIN jobs j ON j.id = i.job_id
-             WHERE j.campaign_id = ?
-             ORDER BY j.cell_index, j.sample_index, i.impact",
-        )
-        .bind(id.to_string())
-        .fetch_all(&self.read)
-        .await?;
-        let per_cell = per_cell_and_sample(&rows, cells.len(), |r| {
-            Ok(Impact {
-                grain_mass_kg: r.get(2),
-                mass_loss_kg: r.get(3),
-            })
-        })?;
+        // An impact record's grain mass and loss are all the aggregation reads of it.
+        let per_cell = self.cell_records::<Impact>(id, cells.len()).await?;
         // Cells that grew are planned as they are now, not as the spec first planned them.
         let plans = self.cell_plans(id).await?;
         let inputs: Vec<_> = cells
@@ -401,9 +375,7 @@ impl Store {
     }
 
     async fn raw_series(&self, id: Uuid) -> Result<Vec<RawSample>> {
-        let jobs = self
-            .job_records::<ImpactRecord>(id, "impacts", "impact")
-            .await?;
+        let jobs = self.job_records::<ImpactRecord>(id).await?;
         Ok(jobs
             .into_iter()
             .map(|(j, impacts)| RawSample {
@@ -416,13 +388,11 @@ impl Store {
             .collect())
     }
 
-    /// Every job of campaign `id` in cell and sample order, with the records it stored in
-    /// `table` (`impacts` or `slices`, ordered by their `unit` column) parsed as `T`.
+    /// Every job of campaign `id` in cell and sample order, with the records of the units it
+    /// stored, in order, parsed as `T`.
     pub(super) async fn job_records<T: serde::de::DeserializeOwned>(
         &self,
         id: Uuid,
-        table: &str,
-        unit: &str,
     ) -> Result<Vec<(JobKey, Vec<T>)>> {
         let jobs = sqlx::query(
             "SELECT id, cell_index, sample_index, seed, state FROM jobs
@@ -431,17 +401,17 @@ impl Store {
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let rows = sqlx::query(&format!(
-            "SELECT r.job_id, r.record FROM {table} r JOIN jobs j ON j.id = r.job_id
-             WHERE j.campaign_id = ? ORDER BY r.job_id, r.{unit}"
-        ))
+        let rows = sqlx::query(
+            "SELECT u.job_id, u.record FROM units u JOIN jobs j ON j.id = u.job_id
+             WHERE j.campaign_id = ? ORDER BY u.job_id, u.unit",
+        )
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
         let mut records: BTreeMap<i64, Vec<T>> = BTreeMap::new();
         for r in rows {
             let rec: T = serde_json::from_str(&r.get::<String, _>(1))
-                .map_err(|e| Error::Internal(format!("stored {unit} record: {e}")))?;
+                .map_err(|e| Error::Internal(format!("stored unit record: {e}")))?;
             records.entry(r.get(0)).or_default().push(rec);
         }
         Ok(jobs
@@ -471,7 +441,7 @@ impl Store {
     ) -> Result<Vec<JobInfo>> {
         self.campaign_row(id).await?;
         let rows = sqlx::query(
-            "SELECT id, cell_index, sample_index, state, attempts, impacts_done, impacts_planned,
+            "SELECT id, cell_index, sample_index, state, attempts, units_done, units_planned,
                     worker, lease_expires_ms, updated_ms, last_error
              FROM jobs WHERE campaign_id = ?1 AND (?2 IS NULL OR state = ?2)
              ORDER BY cell_index, sample_index LIMIT ?3",
@@ -489,8 +459,8 @@ impl Store {
                     sample: r.get::<i64, _>("sample_index") as u32,
                     state: job_state(&r.get::<String, _>("state"))?,
                     attempts: r.get::<i64, _>("attempts") as u32,
-                    impacts_done: r.get::<i64, _>("impacts_done") as u32,
-                    impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
+                    impacts_done: r.get::<i64, _>("units_done") as u32,
+                    impacts_planned: r.get::<i64, _>("units_planned") as u32,
                     worker: r.get("worker"),
                     lease_expires_ms: r.get("lease_expires_ms"),
                     updated_ms: r.get("updated_ms"),

@@ -30,11 +30,11 @@ pub(super) struct CellPlan {
 impl CellPlan {
     /// The plan in row `r`, whose columns carry the names of [`PLAN_COLUMNS`].
     pub fn from_row(r: &sqlx::sqlite::SqliteRow) -> CellPlan {
-        let impacts = r.get::<i64, _>("impacts") as u32;
+        let impacts = r.get::<i64, _>("units") as u32;
         let samples = r.get::<i64, _>("samples") as u32;
         let until = match (
-            r.get::<Option<i64>, _>("impacts_max"),
-            r.get::<Option<i64>, _>("impacts_step"),
+            r.get::<Option<i64>, _>("units_max"),
+            r.get::<Option<i64>, _>("units_step"),
         ) {
             (Some(max), Some(step)) => Some(UntilSteady {
                 min: impacts.min(max as u32),
@@ -69,8 +69,7 @@ impl CellPlan {
     }
 }
 
-const PLAN_COLUMNS: &str =
-    "impacts, samples, impacts_max, impacts_step, samples_max, target_sem_rel";
+const PLAN_COLUMNS: &str = "units, samples, units_max, units_step, samples_max, target_sem_rel";
 
 impl Store {
     /// Every cell's current plan, in cell order.
@@ -112,9 +111,9 @@ pub(super) async fn settle_cell(
         return Ok(());
     }
     let rows = sqlx::query(
-        "SELECT j.sample_index, i.grain_mass_kg, i.mass_loss_kg
-         FROM impacts i JOIN jobs j ON j.id = i.job_id
-         WHERE j.campaign_id = ? AND j.cell_index = ? ORDER BY j.sample_index, i.impact",
+        "SELECT j.sample_index, u.record
+         FROM units u JOIN jobs j ON j.id = u.job_id
+         WHERE j.campaign_id = ? AND j.cell_index = ? ORDER BY j.sample_index, u.unit",
     )
     .bind(campaign)
     .bind(cell)
@@ -122,13 +121,13 @@ pub(super) async fn settle_cell(
     .await?;
     let mut samples: BTreeMap<u32, Vec<Impact>> = BTreeMap::new();
     for r in &rows {
+        // An impact record's grain mass and loss are all the assessment reads of it.
+        let impact = serde_json::from_str(r.get::<&str, _>(1))
+            .map_err(|e| Error::Internal(format!("stored unit record: {e}")))?;
         samples
             .entry(r.get::<i64, _>(0) as u32)
             .or_default()
-            .push(Impact {
-                grain_mass_kg: r.get(1),
-                mass_loss_kg: r.get(2),
-            });
+            .push(impact);
     }
     let input = CellInput {
         angle_deg: 0.0,
@@ -147,7 +146,7 @@ pub(super) async fn settle_cell(
     match step {
         NextStep::ExtendImpacts(to) => {
             sqlx::query(
-                "UPDATE jobs SET impacts_planned = ?, state = 'queued', lease_id = NULL,
+                "UPDATE jobs SET units_planned = ?, state = 'queued', lease_id = NULL,
                                  worker = NULL, lease_expires_ms = NULL, updated_ms = ?
                  WHERE campaign_id = ? AND cell_index = ?",
             )
@@ -224,7 +223,7 @@ async fn grow_cell(
 ) -> Result<()> {
     let (sql, value) = match plan {
         PlanColumn::Impacts(n) => (
-            "UPDATE cells SET impacts = ? WHERE campaign_id = ? AND cell_index = ?",
+            "UPDATE cells SET units = ? WHERE campaign_id = ? AND cell_index = ?",
             n,
         ),
         PlanColumn::Samples(n) => (
@@ -238,7 +237,7 @@ async fn grow_cell(
         .bind(cell)
         .execute(&mut **tx)
         .await?;
-    sqlx::query("UPDATE campaigns SET impacts_total = impacts_total + ? WHERE id = ?")
+    sqlx::query("UPDATE campaigns SET units_total = units_total + ? WHERE id = ?")
         .bind(added_impacts)
         .bind(campaign)
         .execute(&mut **tx)

@@ -9,7 +9,7 @@ use grit_erosion::ImpactRecord;
 use sqlx::Row;
 use uuid::Uuid;
 
-use super::Store;
+use super::{imp, impact_params, Store};
 use crate::api::{CampaignState, ClaimedJob};
 use crate::checkpoint::CheckpointBytes;
 use crate::loadtest::placeholder_record;
@@ -30,7 +30,7 @@ fn spec(impacts: &str, samples: &str) -> CampaignSpec {
 
 /// Impact `k` (1-based) of job `j`'s sample losing `loss` × its grain mass.
 fn record(j: &ClaimedJob, k: u32, loss: f64) -> ImpactRecord {
-    let grain = j.params.grain_mass_kg_m();
+    let grain = impact_params(j).grain_mass_kg_m();
     placeholder_record(k, grain, loss * grain)
 }
 
@@ -47,7 +47,9 @@ async fn run_one(s: &Store, loss: impl Fn(u32, u32) -> f64) -> ClaimedJob {
         .map(|k| record(&j, k, loss(j.sample, k)))
         .collect();
     let ckpt = j.extendable.then(|| checkpoint(&j));
-    s.complete(j.job_id, j.lease_id, &recs, ckpt).await.unwrap();
+    s.complete(j.job_id, j.lease_id, imp(&recs), ckpt)
+        .await
+        .unwrap();
     j
 }
 
@@ -200,14 +202,14 @@ async fn a_repeated_complete_grows_nothing_twice() {
     let j = run_one(&s, |_, _| 0.0).await;
     // The worker did not hear the answer and sends the same complete again.
     let e = s
-        .complete(j.job_id, j.lease_id, &[], Some(checkpoint(&j)))
+        .complete(j.job_id, j.lease_id, imp(&[]), Some(checkpoint(&j)))
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
     let st = s.status(id).await.unwrap();
     assert_eq!((st.jobs.queued, st.impacts_total), (1, 25));
     let e = s
-        .complete(j.job_id, Uuid::new_v4(), &[], None)
+        .complete(j.job_id, Uuid::new_v4(), imp(&[]), None)
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);

@@ -8,7 +8,7 @@ use grit_erosion::campaign::CampaignSpec;
 use grit_erosion::ImpactRecord;
 use uuid::Uuid;
 
-use super::Store;
+use super::{imp, Store};
 
 /// Impact `k` of a sample of the campaign below (default grain), losing a little.
 fn record(k: u32) -> ImpactRecord {
@@ -35,9 +35,9 @@ async fn a_refused_request_in_a_group_leaves_nothing_and_fails_no_other() {
     // are applied in one group, in this order.
     let (gap, stale, good, claimed) = tokio::join!(
         // Impact 1 comes before the gap: nothing of the refused heartbeat may stay.
-        s.heartbeat(a.job_id, a.lease_id, &with_gap, None),
-        s.heartbeat(b.job_id, Uuid::new_v4(), &one, None),
-        s.complete(b.job_id, b.lease_id, &both, None),
+        s.heartbeat(a.job_id, a.lease_id, imp(&with_gap), None),
+        s.heartbeat(b.job_id, Uuid::new_v4(), imp(&one), None),
+        s.complete(b.job_id, b.lease_id, imp(&both), None),
         s.claim("c"),
     );
     assert_eq!(gap.unwrap_err().status(), StatusCode::UNPROCESSABLE_ENTITY);
@@ -46,14 +46,14 @@ async fn a_refused_request_in_a_group_leaves_nothing_and_fails_no_other() {
     let c = claimed.unwrap().unwrap();
     assert_ne!(c.job_id, a.job_id);
     assert_ne!(c.job_id, b.job_id);
-    let stored: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM impacts WHERE job_id = ?")
+    let stored: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM units WHERE job_id = ?")
         .bind(a.job_id)
         .fetch_one(&s.read)
         .await
         .unwrap();
     assert_eq!(stored, 0, "nothing of the refused heartbeat stays");
     let late = s
-        .heartbeat(b.job_id, b.lease_id, &[], None)
+        .heartbeat(b.job_id, b.lease_id, imp(&[]), None)
         .await
         .unwrap_err();
     assert_eq!(

@@ -8,7 +8,7 @@ use grit_erosion::campaign::{AnySpec, Scene};
 use grit_erosion::jet::JetSlice;
 use grit_sph::crater::CraterSample;
 
-use super::{Reported, Store};
+use super::{imp, jet as slices, Reported, Store};
 use crate::api::AnyResults;
 use crate::error::Error;
 
@@ -54,9 +54,9 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
         .await
         .unwrap();
     let spec = AnySpec::from_json(JET).unwrap();
-    let created = s.create_any(&spec, Some("k")).await.unwrap();
+    let created = s.create(&spec, Some("k")).await.unwrap();
     assert_eq!((created.jobs, created.impacts_total), (2, 6));
-    let again = s.create_any(&spec, Some("k")).await.unwrap();
+    let again = s.create(&spec, Some("k")).await.unwrap();
     assert!(
         !again.created,
         "the idempotency key holds for jet specs too"
@@ -64,21 +64,14 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
     let list = s.list_campaigns().await.unwrap();
     assert_eq!(list[0].scene, Scene::Jet);
     let j = s.claim("w").await.unwrap().unwrap();
-    let jet = j.jet.clone().expect("a jet claim carries its run");
+    assert_eq!(j.scene, "jet", "a jet claim names its scene");
+    let jet: grit_erosion::jet::JetParams = serde_json::from_value(j.params.clone()).unwrap();
     assert_eq!((jet.velocity_m_s, j.impacts_planned), (400.0, 3));
-    let wire = serde_json::to_value(&j).unwrap();
-    assert!(
-        wire["params"].is_null(),
-        "no impact scene on the wire: {wire}"
-    );
     // Slices continue the stored series; repeats are skipped, gaps refused.
-    let beat = |slices: Vec<JetSlice>| {
+    let beat = |recs: Vec<JetSlice>| {
         let s = &s;
         let j = &j;
-        async move {
-            s.heartbeat_with(j.job_id, j.lease_id, Reported::slices(&slices), None)
-                .await
-        }
+        async move { s.heartbeat(j.job_id, j.lease_id, slices(&recs), None).await }
     };
     assert_eq!(beat(vec![slice(1)]).await.unwrap().impacts_done, 1);
     assert_eq!(
@@ -87,36 +80,36 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
     );
     assert_eq!(
         field(beat(vec![slice(4)]).await.unwrap_err()),
-        "slices[0].slice"
+        "units[0].slice"
     );
     let mut bad = slice(3);
     bad.sample.t_s = f64::NAN;
     assert_eq!(
         field(beat(vec![bad]).await.unwrap_err()),
-        "slices[0].sample.t_s"
+        "units[0].sample.t_s"
     );
     // Past the run's time and a slice (3 µs + 1 µs), or more mass than the target holds.
     let mut late = slice(3);
     late.sample.t_s = 4.1e-6;
     assert_eq!(
         field(beat(vec![late]).await.unwrap_err()),
-        "slices[0].sample.t_s"
+        "units[0].sample.t_s"
     );
     let mut heavy = slice(3);
     heavy.sample.mass_loss_kg_m = 1e307;
     assert_eq!(
         field(beat(vec![heavy]).await.unwrap_err()),
-        "slices[0].sample.mass_loss_kg_m"
+        "units[0].sample.mass_loss_kg_m"
     );
     let impacts = s
-        .heartbeat(j.job_id, j.lease_id, &[placeholder()], None)
+        .heartbeat(j.job_id, j.lease_id, imp(&[placeholder()]), None)
         .await;
-    assert_eq!(field(impacts.unwrap_err()), "impacts");
+    assert_eq!(field(impacts.unwrap_err()), "units");
     let early = s
-        .complete_with(j.job_id, j.lease_id, Reported::default(), None)
+        .complete(j.job_id, j.lease_id, Reported::none(), None)
         .await;
-    assert_eq!(field(early.unwrap_err()), "slices");
-    s.complete_with(j.job_id, j.lease_id, Reported::slices(&[slice(3)]), None)
+    assert_eq!(field(early.unwrap_err()), "units");
+    s.complete(j.job_id, j.lease_id, slices(&[slice(3)]), None)
         .await
         .unwrap();
     let status = s.status(created.id).await.unwrap();
@@ -150,19 +143,19 @@ async fn an_impact_job_takes_no_slices() {
             "allow_short_samples": true, "spacing_m": 25e-6}"#,
     )
     .unwrap();
-    s.create_any(&spec, None).await.unwrap();
+    s.create(&spec, None).await.unwrap();
     let j = s.claim("w").await.unwrap().unwrap();
-    assert!(j.jet.is_none());
+    assert_eq!(j.scene, "impact");
     let wire = serde_json::to_value(&j).unwrap();
     assert!(
-        wire["params"].is_object() && wire.get("jet").is_none(),
+        wire["params"].is_object() && wire["scene"] == "impact",
         "{wire}"
     );
     let e = s
-        .heartbeat_with(j.job_id, j.lease_id, Reported::slices(&[slice(1)]), None)
+        .heartbeat(j.job_id, j.lease_id, slices(&[slice(1)]), None)
         .await
         .unwrap_err();
-    assert_eq!(field(e), "slices");
+    assert_eq!(field(e), "units");
 }
 
 fn placeholder() -> grit_erosion::ImpactRecord {

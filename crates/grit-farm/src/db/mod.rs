@@ -10,7 +10,6 @@ use std::path::Path;
 use std::str::FromStr;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use grit_erosion::campaign::Scene;
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
 };
@@ -27,7 +26,27 @@ mod jet;
 mod worker;
 mod workers;
 
+pub use checkpoints::StoredJob;
 pub use worker::Reported;
+
+/// A report of impact records, for the tests.
+#[cfg(test)]
+fn imp(records: &[grit_erosion::ImpactRecord]) -> Reported {
+    Reported::of::<grit_erosion::Sample>(records).expect("records serialise")
+}
+
+/// The impact scene of a claim, for the tests.
+#[cfg(test)]
+fn impact_params(job: &crate::api::ClaimedJob) -> grit_erosion::ImpactParams {
+    assert_eq!(job.scene, "impact");
+    serde_json::from_value(job.params.clone()).expect("an impact claim's params")
+}
+
+/// A report of jet slices, for the tests.
+#[cfg(test)]
+fn jet(records: &[grit_erosion::jet::JetSlice]) -> Reported {
+    Reported::of::<grit_erosion::jet::JetRun>(records).expect("records serialise")
+}
 
 #[cfg(test)]
 mod extend_tests;
@@ -56,6 +75,8 @@ pub struct Store {
     pub lease_ttl: Duration,
     /// Attempts (lost or failed leases) after which a job stays `failed`.
     pub max_attempts: u32,
+    /// The scenes whose jobs this store's coordinator runs.
+    pub scenes: crate::scenes::SceneRegistry,
 }
 
 /// When a commit counts as done, and so when a write is answered: SQLite's `synchronous`
@@ -124,6 +145,7 @@ impl Store {
             read,
             lease_ttl,
             max_attempts: max_attempts.max(1),
+            scenes: Default::default(),
         })
     }
 
@@ -160,25 +182,36 @@ async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool>
     Ok(clean)
 }
 
-/// A campaign's stored records, each row (cell index, sample index, …) taken by `take`, grouped
-/// per cell (`cells` of them) and per sample in the rows' order; rows of cells beyond `cells` are
-/// left out.
-fn per_cell_and_sample<T>(
-    rows: &[sqlx::sqlite::SqliteRow],
-    cells: usize,
-    take: impl Fn(&sqlx::sqlite::SqliteRow) -> Result<T>,
-) -> Result<Vec<std::collections::BTreeMap<u32, Vec<T>>>> {
-    use sqlx::Row;
-    let mut per_cell: Vec<std::collections::BTreeMap<u32, Vec<T>>> =
-        (0..cells).map(|_| Default::default()).collect();
-    for r in rows {
-        let cell = r.get::<i64, _>(0) as usize;
-        let sample = r.get::<i64, _>(1) as u32;
-        if let Some(m) = per_cell.get_mut(cell) {
-            m.entry(sample).or_default().push(take(r)?);
+impl Store {
+    /// Campaign `id`'s stored unit records parsed as `T`, grouped per cell (`cells` of them)
+    /// and per sample, in unit order; records of cells beyond `cells` are left out.
+    async fn cell_records<T: serde::de::DeserializeOwned>(
+        &self,
+        id: Uuid,
+        cells: usize,
+    ) -> Result<Vec<std::collections::BTreeMap<u32, Vec<T>>>> {
+        let rows = sqlx::query(
+            "SELECT j.cell_index, j.sample_index, u.record
+             FROM units u JOIN jobs j ON j.id = u.job_id
+             WHERE j.campaign_id = ?
+             ORDER BY j.cell_index, j.sample_index, u.unit",
+        )
+        .bind(id.to_string())
+        .fetch_all(&self.read)
+        .await?;
+        let mut per_cell: Vec<std::collections::BTreeMap<u32, Vec<T>>> =
+            (0..cells).map(|_| Default::default()).collect();
+        for r in &rows {
+            let cell = r.get::<i64, _>(0) as usize;
+            let sample = r.get::<i64, _>(1) as u32;
+            if let Some(m) = per_cell.get_mut(cell) {
+                let rec = serde_json::from_str(r.get::<&str, _>(2))
+                    .map_err(|e| Error::Internal(format!("stored unit record: {e}")))?;
+                m.entry(sample).or_default().push(rec);
+            }
         }
+        Ok(per_cell)
     }
-    Ok(per_cell)
 }
 
 /// Parses a uuid the store wrote.
@@ -215,7 +248,8 @@ pub(crate) async fn by_idempotency_key(
 /// A campaign row to insert: everything but its cells and jobs.
 pub(crate) struct NewCampaign<'a> {
     pub id: Uuid,
-    pub scene: Scene,
+    /// The scene's kind (`grit_erosion::Scene::KIND`).
+    pub scene: &'static str,
     pub name: Option<&'a str>,
     pub spec_json: &'a str,
     pub samples: u32,
@@ -232,7 +266,7 @@ pub(crate) async fn insert_campaign(
     c: NewCampaign<'_>,
 ) -> Result<i64> {
     Ok(sqlx::query(
-        "INSERT INTO campaigns (id, name, spec, samples, impacts_total, max_attempts,
+        "INSERT INTO campaigns (id, name, spec, samples, units_total, max_attempts,
                                 idempotency_key, created_ms, scene)
          VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING rowid",
     )
@@ -244,7 +278,7 @@ pub(crate) async fn insert_campaign(
     .bind(c.max_attempts as i64)
     .bind(c.idempotency_key)
     .bind(c.now)
-    .bind(c.scene.as_str())
+    .bind(c.scene)
     .fetch_one(&mut **tx)
     .await?
     .get(0))
@@ -266,7 +300,7 @@ pub(crate) async fn insert_queued_jobs(
     for chunk in jobs.chunks(400) {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
             "INSERT INTO jobs (campaign_id, campaign_seq, cell_index, sample_index, seed,
-                               impacts_planned, state, updated_ms) ",
+                               units_planned, state, updated_ms) ",
         );
         qb.push_values(chunk, |mut b, (cell, sample, impacts, seed)| {
             b.push_bind(campaign)

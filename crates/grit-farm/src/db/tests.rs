@@ -6,7 +6,7 @@ use std::time::Duration;
 use grit_erosion::campaign::CampaignSpec;
 use uuid::Uuid;
 
-use super::Store;
+use super::{imp, impact_params, Store};
 use crate::api::{CampaignState, JobState};
 use crate::error::Error;
 
@@ -55,7 +55,9 @@ async fn workers_are_listed_idle_or_with_the_job_they_hold() {
     let id = s.create_campaign(&spec, None).await.unwrap().id;
     let j = s.claim("busy").await.unwrap().unwrap();
     tokio::time::sleep(Duration::from_millis(5)).await;
-    s.heartbeat(j.job_id, j.lease_id, &[], None).await.unwrap();
+    s.heartbeat(j.job_id, j.lease_id, imp(&[]), None)
+        .await
+        .unwrap();
     let w = s.workers(Duration::from_secs(60)).await.unwrap();
     let names: Vec<&str> = w.workers.iter().map(|w| w.name.as_str()).collect();
     assert_eq!(names, ["busy", "idle"], "most recently seen first");
@@ -65,7 +67,9 @@ async fn workers_are_listed_idle_or_with_the_job_they_hold() {
     assert_eq!(held[0].last_heartbeat_ms, w.workers[0].last_seen_ms);
     assert!(w.workers[1].jobs.is_empty());
     // A failed attempt clears the job's worker, but the worker stays listed.
-    s.fail(j.job_id, j.lease_id, "boom", &[]).await.unwrap();
+    s.fail(j.job_id, j.lease_id, "boom", imp(&[]))
+        .await
+        .unwrap();
     let w = s.workers(Duration::from_secs(60)).await.unwrap();
     assert!(w.workers.iter().all(|w| w.jobs.is_empty()));
     let queued = s.jobs(id, Some(JobState::Queued), 10).await.unwrap();
@@ -84,15 +88,15 @@ async fn failure_reports_keep_the_error_and_stale_leases_get_409() {
     let id = s.create_campaign(&spec, None).await.unwrap().id;
     let j = s.claim("w").await.unwrap().unwrap();
     let e = s
-        .heartbeat(j.job_id, Uuid::new_v4(), &[], None)
+        .heartbeat(j.job_id, Uuid::new_v4(), imp(&[]), None)
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
-    s.fail(j.job_id, j.lease_id, "impact 1: unstable", &[])
+    s.fail(j.job_id, j.lease_id, "impact 1: unstable", imp(&[]))
         .await
         .unwrap();
     let e = s
-        .fail(j.job_id, j.lease_id, "again", &[])
+        .fail(j.job_id, j.lease_id, "again", imp(&[]))
         .await
         .unwrap_err();
     assert_eq!(
@@ -101,7 +105,7 @@ async fn failure_reports_keep_the_error_and_stale_leases_get_409() {
         "the lease ended"
     );
     let j2 = s.claim("w").await.unwrap().unwrap();
-    s.fail(j2.job_id, j2.lease_id, "impact 1: unstable", &[])
+    s.fail(j2.job_id, j2.lease_id, "impact 1: unstable", imp(&[]))
         .await
         .unwrap();
     let st = s.status(id).await.unwrap();
@@ -218,13 +222,15 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
         .heartbeat(
             j.job_id,
             j.lease_id,
-            &records[..350],
+            imp(&records[..350]),
             Some(CheckpointBytes::new(350, bytes.clone())),
         )
         .await
         .unwrap();
     assert_eq!(beat.impacts_done, 350);
-    s.release(j.job_id, j.lease_id, &[], None).await.unwrap();
+    s.release(j.job_id, j.lease_id, imp(&[]), None)
+        .await
+        .unwrap();
     let again = s.claim("w").await.unwrap().unwrap();
     assert_eq!(again.impacts_done, 350);
     assert_eq!(
@@ -232,22 +238,28 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
         serde_json::to_value(Some(Checkpoint::from_bytes(j.job_id, 350, &bytes))).unwrap()
     );
     // Impacts already stored are skipped.
-    s.complete(again.job_id, again.lease_id, &records[300..], None)
+    s.complete(again.job_id, again.lease_id, imp(&records[300..]), None)
         .await
         .unwrap();
     let stored: Vec<(String, f64)> =
-        sqlx::query_as("SELECT record, mass_loss_kg FROM impacts WHERE job_id = ? ORDER BY impact")
+        sqlx::query_as("SELECT record, lost_kg_m FROM units WHERE job_id = ? ORDER BY unit")
             .bind(j.job_id)
             .fetch_all(&s.read)
             .await
             .unwrap();
     assert_eq!(stored.len(), 400);
-    for (rec, (json, loss)) in records.iter().zip(&stored) {
+    let mut lost = 0.0;
+    for (rec, (json, lost_after)) in records.iter().zip(&stored) {
         assert_eq!(
             serde_json::from_str::<grit_erosion::ImpactRecord>(json).unwrap(),
             *rec
         );
-        assert_eq!(loss.to_bits(), rec.mass_loss_kg.to_bits());
+        lost += rec.mass_loss_kg;
+        assert_eq!(
+            lost_after.to_bits(),
+            f64::to_bits(lost),
+            "the job's loss after each"
+        );
     }
     let kept: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM checkpoints")
         .fetch_one(&s.read)
@@ -265,12 +277,12 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
     let spec = CampaignSpec::from_json(TINY).unwrap();
     s.create_campaign(&spec, None).await.unwrap();
     let j = s.claim("w").await.unwrap().unwrap();
-    let grain = j.params.grain_mass_kg_m();
+    let grain = impact_params(&j).grain_mass_kg_m();
     let refused = |rec| {
         let s = &s;
         let j = &j;
         async move {
-            match s.heartbeat(j.job_id, j.lease_id, &[rec], None).await {
+            match s.heartbeat(j.job_id, j.lease_id, imp(&[rec]), None).await {
                 Err(Error::Invalid { field, .. }) => field,
                 other => panic!("expected a 422, got {other:?}"),
             }
@@ -279,23 +291,23 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
     // A grain other than the cell's would put the sample's points at the wrong abscissa.
     assert_eq!(
         refused(placeholder_record(1, 1.7e308, 0.0)).await,
-        "impacts[0].grain_mass_kg"
+        "units[0].grain_mass_kg"
     );
     assert_eq!(
         refused(placeholder_record(1, grain * (1.0 + 1e-15), 0.0)).await,
-        "impacts[0].grain_mass_kg"
+        "units[0].grain_mass_kg"
     );
     // Finite but more than the whole surface: its sums would overflow to infinity.
-    let surface = j.params.surface_mass_kg_m();
+    let surface = impact_params(&j).surface_mass_kg_m();
     assert_eq!(
         refused(placeholder_record(1, grain, 1e307)).await,
-        "impacts[0].mass_loss_kg"
+        "units[0].mass_loss_kg"
     );
     assert_eq!(
         refused(placeholder_record(1, grain, surface * 1.001)).await,
-        "impacts[0].mass_loss_kg"
+        "units[0].mass_loss_kg"
     );
-    let stored: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM impacts")
+    let stored: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM units")
         .fetch_one(&s.read)
         .await
         .unwrap();
@@ -304,7 +316,7 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
         .heartbeat(
             j.job_id,
             j.lease_id,
-            &[placeholder_record(1, grain, surface)],
+            imp(&[placeholder_record(1, grain, surface)]),
             None,
         )
         .await
@@ -316,10 +328,10 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
     // The bound holds for the sample's loss in all, not per impact.
     assert_eq!(
         refused(placeholder_record(2, grain, surface * 1e-3)).await,
-        "impacts[0].mass_loss_kg"
+        "units[0].mass_loss_kg"
     );
     // The record's two copies of the loss must agree.
     let mut two = placeholder_record(2, grain, 0.0);
     two.outcome.mass_loss_kg = 1e-9;
-    assert_eq!(refused(two).await, "impacts[0].mass_loss_kg");
+    assert_eq!(refused(two).await, "units[0].mass_loss_kg");
 }

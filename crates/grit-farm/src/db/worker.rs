@@ -5,14 +5,13 @@
 //! That writer is the farm's bottleneck, so what needs no database is done by the caller
 //! before or after it: impact records are serialised and checkpoints decoded and hashed
 //! before a request is queued, and a lease's scene is parsed and its checkpoint encoded
-//! after the claim has committed. A jet job's lease holder reports slices, stored in their own
-//! table, where an impact job's reports impacts; the rules are the same.
+//! after the claim has committed. Every scene's units (impacts, jet slices) go in one table,
+//! checked by the scene's own rules (`grit_erosion::Scene::check_record`).
 
 use std::time::Duration;
 
 use base64::Engine;
-use grit_erosion::jet::{JetParams, JetRun, JetSlice};
-use grit_erosion::{ImpactParams, ImpactRecord, Sample, Scene};
+use grit_erosion::Scene;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
@@ -28,9 +27,9 @@ pub(super) const MAX_ERROR_CHARS: usize = 4000;
 /// Workers silent for longer are forgotten, so the table of names cannot grow without end.
 const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 
-/// Impact rows inserted by one statement: 6 bound values each keeps it under SQLite's
-/// smallest limit on bound variables (999).
-const IMPACT_ROWS_PER_INSERT: usize = 150;
+/// Unit rows inserted by one statement: 5 bound values each keeps it under SQLite's smallest
+/// limit on bound variables (999).
+const UNIT_ROWS_PER_INSERT: usize = 150;
 
 /// A checkpoint as stored.
 struct StoredCheckpoint {
@@ -69,7 +68,7 @@ pub(super) struct Leased {
     done: i64,
     /// `cells.params`: the scene as JSON.
     params: String,
-    /// `campaigns.scene`: `impact` or `jet`.
+    /// `campaigns.scene`: the scene's kind.
     scene: String,
     extendable: bool,
     checkpoint: Option<StoredCheckpoint>,
@@ -79,12 +78,7 @@ impl Leased {
     /// The claim's answer: the scene parsed and the checkpoint enveloped.
     fn claimed(self) -> Result<ClaimedJob> {
         let job_id = self.job_id;
-        let (params, jet) = if self.scene == "jet" {
-            let jet: JetParams = stored_params(job_id, &self.params)?;
-            (ImpactParams::default(), Some(jet))
-        } else {
-            (stored_params(job_id, &self.params)?, None)
-        };
+        let params: serde_json::Value = stored_params(job_id, &self.params)?;
         Ok(ClaimedJob {
             job_id,
             lease_id: self.lease,
@@ -95,77 +89,100 @@ impl Leased {
             seed: self.seed as u64,
             impacts_planned: self.planned as u32,
             impacts_done: self.done as u32,
+            scene: self.scene,
             params,
-            jet,
             extendable: self.extendable,
             checkpoint: self.checkpoint.map(|c| c.envelope(job_id)),
         })
     }
 }
 
-/// A record to store (an impact, a jet slice), serialised before it is queued so the writer
-/// only binds it.
-pub(super) struct NewRecord<R> {
-    /// The record, for its scene's checks and its columns.
-    record: R,
-    /// The whole record as JSON, with round-trip float formatting (every f64 comes back
-    /// bit for bit; a slice's profile included).
-    json: String,
-}
-
-/// `records` ready to store.
-fn serialised<R: serde::Serialize + Clone>(records: &[R]) -> Result<Vec<NewRecord<R>>> {
-    records
-        .iter()
-        .map(|rec| {
-            Ok(NewRecord {
-                record: rec.clone(),
-                json: serde_json::to_string(rec).map_err(|e| Error::Internal(e.to_string()))?,
-            })
-        })
-        .collect()
-}
-
-/// What a lease holder reports with a write: the finished impacts of an impact job, or the
-/// finished slices of a jet job (the other one empty).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Reported<'a> {
-    /// Impacts, for an impact job.
-    pub impacts: &'a [ImpactRecord],
-    /// Slices, for a jet job.
-    pub slices: &'a [JetSlice],
-}
-
-impl<'a> Reported<'a> {
-    /// Impacts of an impact job.
-    pub fn impacts(impacts: &'a [ImpactRecord]) -> Self {
-        Reported {
-            impacts,
-            slices: &[],
-        }
-    }
-
-    /// Slices of a jet job.
-    pub fn slices(slices: &'a [JetSlice]) -> Self {
-        Reported {
-            impacts: &[],
-            slices,
-        }
-    }
-}
-
-/// A report ready to store: records serialised before the writer sees them.
+/// A lease holder's report ready to store: its records serialised before it is queued, so
+/// the writer only checks and binds them, whatever the scene.
 pub(super) struct NewUnits {
-    pub impacts: Vec<NewRecord<ImpactRecord>>,
-    pub slices: Vec<NewRecord<JetSlice>>,
+    /// The scene the records are of ([`Scene::KIND`]): a job of another scene refuses them.
+    kind: &'static str,
+    /// The unit in words ([`Scene::UNIT`]), also the name of a record's number field.
+    unit: &'static str,
+    /// Each record's unit number (1-based) and the record as JSON, with round-trip float
+    /// formatting (every f64 comes back bit for bit).
+    rows: Vec<(u32, String)>,
+    /// The scene's checks of the records.
+    check: Box<dyn CheckUnits>,
+}
+
+/// What a lease holder reports with a write: the records of the units it finished, of its
+/// job's scene, ready for the store.
+pub struct Reported(pub(super) NewUnits);
+
+impl Reported {
+    /// `records` of scene `S`.
+    pub fn of<S: Scene>(records: &[S::Record]) -> Result<Reported> {
+        NewUnits::of::<S>(records).map(Reported)
+    }
+
+    /// A report without units.
+    pub fn none() -> Reported {
+        Reported(NewUnits {
+            kind: "",
+            unit: "unit",
+            rows: Vec::new(),
+            check: Box::new(NoUnits),
+        })
+    }
+}
+
+/// The check of a report without units: there is nothing to check.
+struct NoUnits;
+
+impl CheckUnits for NoUnits {
+    fn check(&self, _: i64, _: &str, _: &[usize], _: f64) -> Result<Vec<f64>> {
+        Ok(Vec::new())
+    }
 }
 
 impl NewUnits {
-    fn of(r: Reported<'_>) -> Result<NewUnits> {
+    /// `records` of scene `S`, serialised.
+    fn of<S: Scene>(records: &[S::Record]) -> Result<NewUnits> {
+        let rows = records
+            .iter()
+            .map(|rec| {
+                let json =
+                    serde_json::to_string(rec).map_err(|e| Error::Internal(e.to_string()))?;
+                Ok((S::unit_of(rec), json))
+            })
+            .collect::<Result<_>>()?;
         Ok(NewUnits {
-            impacts: serialised(r.impacts)?,
-            slices: serialised(r.slices)?,
+            kind: S::KIND,
+            unit: S::UNIT,
+            rows,
+            check: Box::new(Records::<S>(records.to_vec())),
         })
+    }
+}
+
+/// A scene's checks of reported records, its type erased so one writer queue carries every
+/// scene's reports.
+trait CheckUnits: Send + Sync {
+    /// Checks records `new` (indices into the report) against the job's parameters as stored
+    /// (`params` JSON), the job having lost `lost` kg/m before the first; returns the loss after
+    /// each. A refusal names the field as `units[i].…`.
+    fn check(&self, job_id: i64, params: &str, new: &[usize], lost: f64) -> Result<Vec<f64>>;
+}
+
+/// The records of scene `S` in a report.
+struct Records<S: Scene>(Vec<S::Record>);
+
+impl<S: Scene> CheckUnits for Records<S> {
+    fn check(&self, job_id: i64, params: &str, new: &[usize], mut lost: f64) -> Result<Vec<f64>> {
+        let p: S::Params = stored_params(job_id, params)?;
+        new.iter()
+            .map(|&i| {
+                lost = S::check_record(&p, &self.0[i], lost)
+                    .map_err(|e| Error::invalid(format!("units[{i}].{}", e.field), e.rule))?;
+                Ok(lost)
+            })
+            .collect()
     }
 }
 
@@ -223,31 +240,19 @@ impl Store {
         }
     }
 
-    /// Renews the lease, stores finished impacts and an optional checkpoint (checked by the
-    /// caller: `crate::checkpoint::verify_upload`).
+    /// Renews the lease, stores the finished units and an optional
+    /// checkpoint (checked by the caller: `crate::checkpoint::verify_upload`).
     pub async fn heartbeat(
         &self,
         job_id: i64,
         lease: Uuid,
-        impacts: &[ImpactRecord],
-        checkpoint: Option<CheckpointBytes>,
-    ) -> Result<HeartbeatResponse> {
-        self.heartbeat_with(job_id, lease, Reported::impacts(impacts), checkpoint)
-            .await
-    }
-
-    /// [`Store::heartbeat`] for either scene: impacts of an impact job, slices of a jet job.
-    pub async fn heartbeat_with(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        reported: Reported<'_>,
+        reported: Reported,
         checkpoint: Option<CheckpointBytes>,
     ) -> Result<HeartbeatResponse> {
         let op = Op::Heartbeat {
             job_id,
             lease,
-            units: NewUnits::of(reported)?,
+            units: reported.0,
             checkpoint,
         };
         match self.group.apply(op).await? {
@@ -256,32 +261,20 @@ impl Store {
         }
     }
 
-    /// Stores the last impacts and marks the job done; it must then have every planned impact.
-    /// The checkpoint after the last impact is kept when the job's cell may still grow, and
-    /// a cell whose last job this was is assessed and grown in the same transaction.
+    /// Stores the last units and marks the job done; it must then have every planned unit.
+    /// The checkpoint after the last unit is kept when the job's cell may still grow, and a
+    /// cell whose last job this was is assessed and grown in the same transaction.
     pub async fn complete(
         &self,
         job_id: i64,
         lease: Uuid,
-        impacts: &[ImpactRecord],
-        checkpoint: Option<CheckpointBytes>,
-    ) -> Result<()> {
-        self.complete_with(job_id, lease, Reported::impacts(impacts), checkpoint)
-            .await
-    }
-
-    /// [`Store::complete`] for either scene; a jet job must then have every planned slice.
-    pub async fn complete_with(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        reported: Reported<'_>,
+        reported: Reported,
         checkpoint: Option<CheckpointBytes>,
     ) -> Result<()> {
         let op = Op::Complete {
             job_id,
             lease,
-            units: NewUnits::of(reported)?,
+            units: reported.0,
             checkpoint,
         };
         self.group.apply(op).await.map(drop)
@@ -293,53 +286,29 @@ impl Store {
         job_id: i64,
         lease: Uuid,
         error: &str,
-        impacts: &[ImpactRecord],
-    ) -> Result<()> {
-        self.fail_with(job_id, lease, error, Reported::impacts(impacts))
-            .await
-    }
-
-    /// [`Store::fail`] for either scene.
-    pub async fn fail_with(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        error: &str,
-        reported: Reported<'_>,
+        reported: Reported,
     ) -> Result<()> {
         let op = Op::Fail {
             job_id,
             lease,
             error: error.chars().take(MAX_ERROR_CHARS).collect(),
-            units: NewUnits::of(reported)?,
+            units: reported.0,
         };
         self.group.apply(op).await.map(drop)
     }
 
-    /// Gives a job back without counting an attempt, keeping its impacts and checkpoint.
+    /// Gives a job back without counting an attempt, keeping its units and checkpoint.
     pub async fn release(
         &self,
         job_id: i64,
         lease: Uuid,
-        impacts: &[ImpactRecord],
-        checkpoint: Option<CheckpointBytes>,
-    ) -> Result<()> {
-        self.release_with(job_id, lease, Reported::impacts(impacts), checkpoint)
-            .await
-    }
-
-    /// [`Store::release`] for either scene.
-    pub async fn release_with(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        reported: Reported<'_>,
+        reported: Reported,
         checkpoint: Option<CheckpointBytes>,
     ) -> Result<()> {
         let op = Op::Release {
             job_id,
             lease,
-            units: NewUnits::of(reported)?,
+            units: reported.0,
             checkpoint,
         };
         self.group.apply(op).await.map(drop)
@@ -374,8 +343,7 @@ pub(super) async fn apply_claim(
                          updated_ms = ?
          WHERE id = (SELECT id FROM jobs WHERE state = 'queued'
                      ORDER BY campaign_seq, sample_index, cell_index LIMIT 1)
-         RETURNING id, campaign_id, cell_index, sample_index, seed, impacts_planned,
-                   impacts_done",
+         RETURNING id, campaign_id, cell_index, sample_index, seed, units_planned, units_done",
     )
     .bind(lease.to_string())
     .bind(worker)
@@ -391,7 +359,7 @@ pub(super) async fn apply_claim(
     let cell: i64 = r.get("cell_index");
     // The job's cell and its checkpoint, if any, in one statement.
     let c = sqlx::query(
-        "SELECT c.params, c.impacts, c.impacts_max, k.impacts_done, k.data, k.sha256,
+        "SELECT c.params, c.units, c.units_max, k.units_done, k.data, k.sha256,
                 (SELECT scene FROM campaigns WHERE id = ?2)
          FROM cells c LEFT JOIN checkpoints k ON k.job_id = ?1
          WHERE c.campaign_id = ?2 AND c.cell_index = ?3",
@@ -419,8 +387,8 @@ pub(super) async fn apply_claim(
         cell,
         sample: r.get("sample_index"),
         seed: r.get("seed"),
-        planned: r.get("impacts_planned"),
-        done: r.get("impacts_done"),
+        planned: r.get("units_planned"),
+        done: r.get("units_done"),
         params: c.get(0),
         scene: c.get(6),
         extendable,
@@ -440,7 +408,7 @@ pub(super) async fn apply_heartbeat(
     let Report { now, done, .. } = report(tx, job_id, lease, units, checkpoint).await?;
     let expires = now + lease_ttl.as_millis() as i64;
     sqlx::query(
-        "UPDATE jobs SET lease_expires_ms = ?, impacts_done = ?, updated_ms = ? WHERE id = ?",
+        "UPDATE jobs SET lease_expires_ms = ?, units_done = ?, updated_ms = ? WHERE id = ?",
     )
     .bind(expires)
     .bind(done as i64)
@@ -464,11 +432,10 @@ pub(super) async fn apply_complete(
 ) -> Result<()> {
     let Report { now, held, done } = report(tx, job_id, lease, units, checkpoint).await?;
     if done < held.planned {
-        let unit = held.unit();
         return Err(Error::invalid(
-            unit,
+            "units",
             format!(
-                "the job has {done} of its {} planned {unit}; send the rest before completing",
+                "the job has {done} of its {} planned units; send the rest before completing",
                 held.planned
             ),
         ));
@@ -495,7 +462,7 @@ pub(super) async fn apply_fail(
 ) -> Result<()> {
     let Report { now, done, .. } = report(tx, job_id, lease, units, None).await?;
     sqlx::query(
-        "UPDATE jobs SET attempts = attempts + 1, impacts_done = ?, last_error = ?,
+        "UPDATE jobs SET attempts = attempts + 1, units_done = ?, last_error = ?,
              state = CASE WHEN attempts + 1 >=
                  (SELECT max_attempts FROM campaigns WHERE id = jobs.campaign_id)
                  THEN 'failed' ELSE 'queued' END,
@@ -525,7 +492,7 @@ pub(super) async fn apply_release(
 }
 
 /// The start of a lease holder's write in `tx`: checks the lease, marks the worker seen, and
-/// stores the impacts (or a jet job's slices) and then the checkpoint, if any.
+/// stores the units and then the checkpoint, if any.
 async fn report(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
@@ -536,23 +503,7 @@ async fn report(
     let now = now_ms();
     let held = check_lease(tx, job_id, lease, now).await?;
     touch_worker(tx, held.worker.as_deref(), now).await?;
-    let done = if held.jet {
-        if !units.impacts.is_empty() {
-            return Err(Error::invalid(
-                "impacts",
-                format!("job {job_id} runs the jet scene: report slices, not impacts"),
-            ));
-        }
-        store_slices(tx, job_id, &held, &units.slices, now).await?
-    } else {
-        if !units.slices.is_empty() {
-            return Err(Error::invalid(
-                "slices",
-                format!("job {job_id} runs the impact scene: report impacts, not slices"),
-            ));
-        }
-        store_impacts(tx, job_id, &held, &units.impacts, now).await?
-    };
+    let done = store_units(tx, job_id, &held, units, now).await?;
     if let Some(c) = checkpoint {
         store_checkpoint(tx, job_id, done, c, now).await?;
     }
@@ -571,21 +522,10 @@ struct Held {
     plan: CellPlan,
     /// Whether a checkpoint of the job is stored.
     has_checkpoint: bool,
-    /// Whether the job runs the jet scene (its units are slices).
-    jet: bool,
+    /// The job's scene (`campaigns.scene`).
+    scene: String,
     /// `cells.params`: the scene as JSON, which bounds the records a worker may send.
     params: String,
-}
-
-impl Held {
-    /// The job's unit of progress, as its field is named.
-    fn unit(&self) -> &'static str {
-        if self.jet {
-            "slices"
-        } else {
-            "impacts"
-        }
-    }
 }
 
 async fn check_lease(
@@ -596,10 +536,10 @@ async fn check_lease(
 ) -> Result<Held> {
     let r = sqlx::query(
         "SELECT j.state AS state, j.lease_id AS lease_id, j.lease_expires_ms AS lease_expires_ms,
-                j.impacts_planned AS impacts_planned, j.impacts_done AS impacts_done,
+                j.units_planned AS units_planned, j.units_done AS units_done,
                 j.worker AS worker, j.campaign_id AS campaign_id, j.cell_index AS cell_index,
-                k.impacts AS impacts, k.samples AS samples, k.impacts_max AS impacts_max,
-                k.impacts_step AS impacts_step, k.samples_max AS samples_max,
+                k.units AS units, k.samples AS samples, k.units_max AS units_max,
+                k.units_step AS units_step, k.samples_max AS samples_max,
                 k.target_sem_rel AS target_sem_rel,
                 EXISTS (SELECT 1 FROM checkpoints c WHERE c.job_id = j.id) AS has_checkpoint,
                 (SELECT p.scene FROM campaigns p WHERE p.id = j.campaign_id) AS scene,
@@ -629,14 +569,14 @@ async fn check_lease(
         )));
     }
     Ok(Held {
-        planned: r.get::<i64, _>("impacts_planned") as u32,
-        done: r.get::<i64, _>("impacts_done") as u32,
+        planned: r.get::<i64, _>("units_planned") as u32,
+        done: r.get::<i64, _>("units_done") as u32,
         worker: r.get("worker"),
         campaign: r.get("campaign_id"),
         cell: r.get("cell_index"),
         plan: CellPlan::from_row(&r),
         has_checkpoint: r.get("has_checkpoint"),
-        jet: r.get::<&str, _>("scene") == "jet",
+        scene: r.get("scene"),
         params: r.get("params"),
     })
 }
@@ -651,7 +591,7 @@ async fn end_lease(
     now: i64,
 ) -> Result<()> {
     sqlx::query(
-        "UPDATE jobs SET state = ?1, impacts_done = ?2, lease_id = NULL, lease_expires_ms = NULL,
+        "UPDATE jobs SET state = ?1, units_done = ?2, lease_id = NULL, lease_expires_ms = NULL,
                          worker = CASE WHEN ?1 = 'done' THEN worker END, updated_ms = ?3
          WHERE id = ?4",
     )
@@ -682,9 +622,9 @@ async fn touch_worker(
     Ok(())
 }
 
-/// The order appended records keep (`store_impacts`, `store_slices`): record `n` of a job with
-/// `done` stored and `planned` in all is skipped (false) when already stored, taken (true) when
-/// it is the next, and refused, naming `field`, when it leaves a gap or passes the plan.
+/// The order appended units keep (`store_units`): `unit` `n` of a job with `done` stored and
+/// `planned` in all is skipped (false) when already stored, taken (true) when it is the next,
+/// and refused, naming `field`, when it leaves a gap or passes the plan.
 fn is_next(unit: &str, n: u32, done: u32, planned: u32, field: String) -> Result<bool> {
     if n <= done {
         return Ok(false);
@@ -704,14 +644,15 @@ fn is_next(unit: &str, n: u32, done: u32, planned: u32, field: String) -> Result
     Ok(true)
 }
 
-/// The mass job `job_id`'s stored impacts lost, in all (kg/m).
+/// The mass job `job_id` lost by its last stored unit (kg/m), 0 before the first.
 async fn stored_loss(tx: &mut Transaction<'static, Sqlite>, job_id: i64) -> Result<f64> {
-    let sum: Option<f64> =
-        sqlx::query_scalar("SELECT SUM(mass_loss_kg) FROM impacts WHERE job_id = ?")
-            .bind(job_id)
-            .fetch_one(&mut **tx)
-            .await?;
-    Ok(sum.unwrap_or(0.0))
+    let lost: Option<f64> = sqlx::query_scalar(
+        "SELECT lost_kg_m FROM units WHERE job_id = ? ORDER BY unit DESC LIMIT 1",
+    )
+    .bind(job_id)
+    .fetch_optional(&mut **tx)
+    .await?;
+    Ok(lost.unwrap_or(0.0))
 }
 
 /// The scene a job's cell stored at submission (`cells.params`).
@@ -720,108 +661,64 @@ fn stored_params<T: serde::de::DeserializeOwned>(job_id: i64, params: &str) -> R
         .map_err(|e| Error::Internal(format!("stored params of job {job_id}: {e}")))
 }
 
-/// Appends impacts after those stored; ones already stored are skipped (a resumed job
-/// re-runs impacts past its checkpoint, and a retried heartbeat resends). Every record is
-/// checked before any is written, and the new ones go in with one statement. Returns the
-/// count stored afterwards.
-async fn store_impacts(
+/// Appends units after those stored; ones already stored are skipped (a resumed job re-runs
+/// units past its checkpoint, and a retried heartbeat resends). Every new record is checked
+/// by its scene before any is written, and they go in with one statement. Returns the count
+/// stored afterwards.
+async fn store_units(
     tx: &mut Transaction<'static, Sqlite>,
     job_id: i64,
     held: &Held,
-    impacts: &[NewRecord<ImpactRecord>],
+    units: &NewUnits,
     now: i64,
 ) -> Result<u32> {
+    if units.rows.is_empty() {
+        return Ok(held.done);
+    }
+    if units.kind != held.scene {
+        return Err(Error::invalid(
+            "units",
+            format!(
+                "job {job_id} runs the {} scene: report its units, not {} units",
+                held.scene, units.kind
+            ),
+        ));
+    }
     let mut done = held.done;
-    let mut new = Vec::with_capacity(impacts.len());
-    let mut scene = None;
-    // The sample's loss so far, read once the first new record needs it.
-    let mut lost: Option<f64> = None;
-    for (i, rec) in impacts.iter().enumerate() {
-        let field = |name: &str| format!("impacts[{i}].{name}");
-        if !is_next(
-            "impact",
-            rec.record.impact,
+    let mut new = Vec::with_capacity(units.rows.len());
+    for (i, (n, _)) in units.rows.iter().enumerate() {
+        if is_next(
+            units.unit,
+            *n,
             done,
             held.planned,
-            field("impact"),
+            format!("units[{i}].{}", units.unit),
         )? {
-            continue;
+            new.push(i);
+            done = *n;
         }
-        let p = match &scene {
-            Some(p) => p,
-            None => scene.insert(stored_params::<ImpactParams>(job_id, &held.params)?),
-        };
-        let before = match lost {
-            Some(l) => l,
-            None => stored_loss(tx, job_id).await?,
-        };
-        lost = Some(
-            Sample::check_record(p, &rec.record, before)
-                .map_err(|e| Error::invalid(field(&e.field), e.rule))?,
-        );
-        new.push(rec);
-        done = rec.record.impact;
     }
-    for chunk in new.chunks(IMPACT_ROWS_PER_INSERT) {
+    if new.is_empty() {
+        return Ok(done);
+    }
+    let lost = units
+        .check
+        .check(job_id, &held.params, &new, stored_loss(tx, job_id).await?)?;
+    for chunk in new
+        .iter()
+        .zip(&lost)
+        .collect::<Vec<_>>()
+        .chunks(UNIT_ROWS_PER_INSERT)
+    {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
-            "INSERT INTO impacts (job_id, impact, grain_mass_kg, mass_loss_kg, record, created_ms) ",
+            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms) ",
         );
-        qb.push_values(chunk, |mut b, rec| {
+        qb.push_values(chunk, |mut b, (&i, &lost)| {
+            let (n, json) = &units.rows[i];
             b.push_bind(job_id)
-                .push_bind(rec.record.impact as i64)
-                .push_bind(rec.record.grain_mass_kg)
-                .push_bind(rec.record.mass_loss_kg)
-                .push_bind(rec.json.as_str())
-                .push_bind(now);
-        });
-        qb.build().execute(&mut **tx).await?;
-    }
-    Ok(done)
-}
-
-/// Appends a jet job's slices after those stored, by the rules of [`store_impacts`]: slices
-/// already stored are skipped, the next must be stored + 1, every record is checked before
-/// any is written. Returns the count stored afterwards.
-async fn store_slices(
-    tx: &mut Transaction<'static, Sqlite>,
-    job_id: i64,
-    held: &Held,
-    slices: &[NewRecord<JetSlice>],
-    now: i64,
-) -> Result<u32> {
-    let mut done = held.done;
-    let mut new = Vec::with_capacity(slices.len());
-    let mut scene = None;
-    for (i, rec) in slices.iter().enumerate() {
-        let field = |name: &str| format!("slices[{i}].{name}");
-        if !is_next(
-            "slice",
-            rec.record.slice,
-            done,
-            held.planned,
-            field("slice"),
-        )? {
-            continue;
-        }
-        let p = match &scene {
-            Some(p) => p,
-            None => scene.insert(stored_params::<JetParams>(job_id, &held.params)?),
-        };
-        JetRun::check_record(p, &rec.record, 0.0)
-            .map_err(|e| Error::invalid(field(&e.field), e.rule))?;
-        new.push(rec);
-        done = rec.record.slice;
-    }
-    for chunk in new.chunks(IMPACT_ROWS_PER_INSERT) {
-        let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
-            "INSERT INTO slices (job_id, slice, t_s, mass_loss_kg_m, record, created_ms) ",
-        );
-        qb.push_values(chunk, |mut b, rec| {
-            b.push_bind(job_id)
-                .push_bind(rec.record.slice as i64)
-                .push_bind(rec.record.sample.t_s)
-                .push_bind(rec.record.sample.mass_loss_kg_m)
-                .push_bind(rec.json.as_str())
+                .push_bind(*n as i64)
+                .push_bind(lost)
+                .push_bind(json.as_str())
                 .push_bind(now);
         });
         qb.build().execute(&mut **tx).await?;
@@ -840,17 +737,17 @@ async fn store_checkpoint(
         return Err(Error::invalid(
             "checkpoint.impacts_done",
             format!(
-                "checkpoint after impact {} but only {stored} impacts are stored; send them first",
+                "checkpoint after unit {} but only {stored} units are stored; send them first",
                 c.impacts_done
             ),
         ));
     }
     sqlx::query(
-        "INSERT INTO checkpoints (job_id, impacts_done, data, sha256, updated_ms)
+        "INSERT INTO checkpoints (job_id, units_done, data, sha256, updated_ms)
          VALUES (?, ?, ?, ?, ?)
-         ON CONFLICT (job_id) DO UPDATE SET impacts_done = excluded.impacts_done,
+         ON CONFLICT (job_id) DO UPDATE SET units_done = excluded.units_done,
              data = excluded.data, sha256 = excluded.sha256, updated_ms = excluded.updated_ms
-         WHERE excluded.impacts_done >= checkpoints.impacts_done",
+         WHERE excluded.units_done >= checkpoints.units_done",
     )
     .bind(job_id)
     .bind(c.impacts_done as i64)
@@ -895,8 +792,8 @@ mod tests {
     }
 
     #[test]
-    fn appended_records_are_skipped_taken_or_refused_by_their_number() {
-        let f = || "slices[0].slice".to_string();
+    fn appended_units_are_skipped_taken_or_refused_by_their_number() {
+        let f = || "units[0].slice".to_string();
         assert!(!is_next("slice", 2, 2, 5, f()).unwrap());
         assert!(is_next("slice", 3, 2, 5, f()).unwrap());
         assert_eq!(

@@ -23,7 +23,7 @@ impl Store {
         let mut held: BTreeMap<String, Vec<HeldJob>> = BTreeMap::new();
         for r in sqlx::query(
             "SELECT j.id, j.campaign_id, c.name AS campaign_name, j.cell_index, k.angle_deg,
-                    k.shape, j.sample_index, j.impacts_done, j.impacts_planned, j.updated_ms,
+                    k.shape, j.sample_index, j.units_done, j.units_planned, j.updated_ms,
                     j.lease_expires_ms, j.worker
              FROM jobs j
              JOIN campaigns c ON c.id = j.campaign_id
@@ -41,8 +41,8 @@ impl Store {
                 angle_deg: r.get("angle_deg"),
                 shape: r.get("shape"),
                 sample: r.get::<i64, _>("sample_index") as u32,
-                impacts_done: r.get::<i64, _>("impacts_done") as u32,
-                impacts_planned: r.get::<i64, _>("impacts_planned") as u32,
+                impacts_done: r.get::<i64, _>("units_done") as u32,
+                impacts_planned: r.get::<i64, _>("units_planned") as u32,
                 // Claims and heartbeats are the only writes to a leased job's updated_ms.
                 last_heartbeat_ms: r.get("updated_ms"),
                 lease_expires_ms: r.get::<Option<i64>, _>("lease_expires_ms").unwrap_or(0),

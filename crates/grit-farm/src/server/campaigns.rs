@@ -86,7 +86,7 @@ async fn create_campaign(
             "must be 1 to 200 characters",
         ));
     }
-    let created = s.store.create_any(&spec, key).await?;
+    let created = s.store.create(&spec, key).await?;
     let status = if created.created {
         StatusCode::CREATED
     } else {

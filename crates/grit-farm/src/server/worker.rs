@@ -12,15 +12,13 @@ use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use axum::routing::post;
 use axum::{Json, Router};
-use grit_erosion::jet::JetSlice;
-use grit_erosion::ImpactRecord;
 use serde::Deserialize;
 use serde_json::Value;
 use uuid::Uuid;
 
 use super::AppState;
 use crate::api::*;
-use crate::checkpoint::{verify_any_upload, CheckpointBytes};
+use crate::checkpoint::CheckpointBytes;
 use crate::db::Reported;
 use crate::error::{Error, Result};
 
@@ -39,58 +37,46 @@ struct Report {
     error: Option<String>,
 }
 
-/// A report's units decoded as its job's scene's records.
-#[derive(Default)]
-struct Units {
-    impacts: Vec<ImpactRecord>,
-    slices: Vec<JetSlice>,
-}
-
-impl Units {
-    fn reported(&self) -> Reported<'_> {
-        Reported {
-            impacts: &self.impacts,
-            slices: &self.slices,
-        }
-    }
-}
-
-/// Each of `units` as a record of `R`; a unit that is not one is a 422 naming its field.
-fn records<R: serde::de::DeserializeOwned>(units: Vec<Value>) -> Result<Vec<R>> {
-    units
-        .into_iter()
-        .enumerate()
-        .map(|(i, v)| {
-            serde_path_to_error::deserialize(v).map_err(|e| {
-                let path = e.path().to_string();
-                let at = if path == "." {
-                    format!("units[{i}]")
-                } else {
-                    format!("units[{i}].{path}")
-                };
-                Error::invalid(at, e.into_inner().to_string())
-            })
-        })
-        .collect()
-}
-
 impl Report {
-    /// The units as job `job`'s scene's records; 404 for an unknown job.
-    async fn units(&mut self, s: &AppState, job: i64) -> Result<Units> {
+    /// The units and checkpoint of a write to job `job`, checked by the job's scene: the
+    /// units decoded as its records (a 422 naming `units[i]…` for one that is not), the
+    /// checkpoint verified (`crate::checkpoint::verify_upload`) as the job's own. One read of
+    /// the job serves both; 404 for an unknown job.
+    async fn checked(
+        &mut self,
+        s: &AppState,
+        job: i64,
+    ) -> Result<(Reported, Option<CheckpointBytes>)> {
         let units = std::mem::take(&mut self.units);
-        if units.is_empty() {
-            return Ok(Units::default());
+        let checkpoint = self.checkpoint.take();
+        if units.is_empty() && checkpoint.is_none() {
+            return Ok((Reported::none(), None));
         }
-        Ok(match s.store.job_scene(job).await?.as_str() {
-            "jet" => Units {
-                slices: records(units)?,
-                ..Units::default()
-            },
-            _ => Units {
-                impacts: records(units)?,
-                ..Units::default()
-            },
+        let stored = s.store.stored_job(job).await?;
+        let scene = s.store.scenes.get(&stored.scene)?;
+        let reported = if units.is_empty() {
+            Reported::none()
+        } else {
+            scene.decode(units)?
+        };
+        let Some(c) = checkpoint else {
+            return Ok((reported, None));
+        };
+        // Decoding a checkpoint of a large surface or a jet's world takes milliseconds: off
+        // the async threads.
+        let scenes = s.store.scenes.clone();
+        let checked = tokio::task::spawn_blocking(move || {
+            scenes
+                .get(&stored.scene)
+                .map(|scene| scene.verify_upload(&c, job, &stored.params, stored.seed))
         })
+        .await
+        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))??;
+        let bytes = checked.map_err(|e| {
+            tracing::warn!(job, error = %e, "checkpoint refused; nothing of the request stored");
+            Error::invalid(e.field, e.rule)
+        })?;
+        Ok((reported, Some(bytes)))
     }
 
     /// The 422 for a field the endpoint does not take.
@@ -189,29 +175,6 @@ fn job_id(raw: &str) -> Result<i64> {
         .map_err(|_| Error::NotFound(format!("job {raw} (job ids are integers)")))
 }
 
-/// The bytes and checksum of `checkpoint` for the store, refused with a 422 naming the field
-/// at fault unless it is intact and job `job_id`'s own (`crate::checkpoint::verify_upload`);
-/// 404 for an unknown job.
-async fn check_checkpoint(
-    s: &AppState,
-    job_id: i64,
-    checkpoint: Option<Checkpoint>,
-) -> Result<Option<CheckpointBytes>> {
-    let Some(c) = checkpoint else {
-        return Ok(None);
-    };
-    let (params, seed) = s.store.job_params(job_id).await?;
-    // Decoding a checkpoint of a large surface or a jet's world takes milliseconds: off the
-    // async threads.
-    let checked = tokio::task::spawn_blocking(move || verify_any_upload(&c, job_id, &params, seed))
-        .await
-        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
-    checked.map(Some).map_err(|e| {
-        tracing::warn!(job = job_id, error = %e, "checkpoint refused; nothing of the request stored");
-        Error::invalid(e.field, e.rule)
-    })
-}
-
 /// Leases the next job; 204 when the queue is empty.
 #[utoipa::path(post, path = "/api/v1/worker/claim", request_body = ClaimRequest,
     responses((status = 200, body = ClaimedJob), (status = 204, description = "no job queued"), (status = 401)),
@@ -245,11 +208,10 @@ async fn heartbeat(
     if req.error.is_some() {
         return Err(Report::refuse("error", "heartbeat"));
     }
-    let units = req.units(&s, job).await?;
-    let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
+    let (units, checkpoint) = req.checked(&s, job).await?;
     Ok(Json(
         s.store
-            .heartbeat_with(job, req.lease_id, units.reported(), checkpoint)
+            .heartbeat(job, req.lease_id, units, checkpoint)
             .await?,
     ))
 }
@@ -268,10 +230,9 @@ async fn complete(
     if req.error.is_some() {
         return Err(Report::refuse("error", "complete"));
     }
-    let units = req.units(&s, job).await?;
-    let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
+    let (units, checkpoint) = req.checked(&s, job).await?;
     s.store
-        .complete_with(job, req.lease_id, units.reported(), checkpoint)
+        .complete(job, req.lease_id, units, checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }
@@ -296,10 +257,8 @@ async fn fail(
         ));
     };
     let error = error.to_string();
-    let units = req.units(&s, job).await?;
-    s.store
-        .fail_with(job, req.lease_id, &error, units.reported())
-        .await?;
+    let (units, _) = req.checked(&s, job).await?;
+    s.store.fail(job, req.lease_id, &error, units).await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
@@ -317,10 +276,9 @@ async fn release(
     if req.error.is_some() {
         return Err(Report::refuse("error", "release"));
     }
-    let units = req.units(&s, job).await?;
-    let checkpoint = check_checkpoint(&s, job, req.checkpoint.take()).await?;
+    let (units, checkpoint) = req.checked(&s, job).await?;
     s.store
-        .release_with(job, req.lease_id, units.reported(), checkpoint)
+        .release(job, req.lease_id, units, checkpoint)
         .await?;
     Ok(StatusCode::NO_CONTENT)
 }

@@ -1,0 +1,112 @@
+//! The farm's view of the scenes it runs: what the coordinator does with a job's reported
+//! units and uploaded checkpoints, for a scene it knows only by its stored kind. Built once
+//! from a [`SceneSet`] (grit's own [`grit_erosion::Scenes`] by default), so a new scene
+//! reaches the farm without a change to it.
+
+use std::collections::BTreeMap;
+use std::marker::PhantomData;
+use std::sync::Arc;
+
+use grit_erosion::{Scene, SceneSet, SceneVisitor};
+use serde_json::Value;
+
+use crate::api::Checkpoint;
+use crate::checkpoint::{verify_upload, CheckpointBytes, CheckpointError};
+use crate::db::Reported;
+use crate::error::{Error, Result};
+
+/// What the coordinator does with one scene's jobs, its type erased.
+pub trait FarmScene: Send + Sync {
+    /// Reported `units` (JSON values) as the scene's records; a unit that is not one is a 422
+    /// naming `units[i]…`.
+    fn decode(&self, units: Vec<Value>) -> Result<Reported>;
+    /// [`verify_upload`] of checkpoint `c` as job `job_id`'s, whose stored parameters are
+    /// `params` (JSON) and seed `seed`: the checked bytes for the store.
+    fn verify_upload(
+        &self,
+        c: &Checkpoint,
+        job_id: i64,
+        params: &str,
+        seed: u64,
+    ) -> std::result::Result<CheckpointBytes, CheckpointError>;
+}
+
+/// [`FarmScene`] of scene `S`.
+struct Ops<S>(PhantomData<fn() -> S>);
+
+impl<S: Scene> FarmScene for Ops<S> {
+    fn decode(&self, units: Vec<Value>) -> Result<Reported> {
+        let records: Vec<S::Record> = units
+            .into_iter()
+            .enumerate()
+            .map(|(i, v)| {
+                serde_path_to_error::deserialize(v).map_err(|e| {
+                    let path = e.path().to_string();
+                    let at = if path == "." {
+                        format!("units[{i}]")
+                    } else {
+                        format!("units[{i}].{path}")
+                    };
+                    Error::invalid(at, e.into_inner().to_string())
+                })
+            })
+            .collect::<Result<_>>()?;
+        Reported::of::<S>(&records)
+    }
+
+    fn verify_upload(
+        &self,
+        c: &Checkpoint,
+        job_id: i64,
+        params: &str,
+        seed: u64,
+    ) -> std::result::Result<CheckpointBytes, CheckpointError> {
+        let params: S::Params = serde_json::from_str(params).map_err(|e| CheckpointError {
+            field: "checkpoint",
+            rule: format!("the job's stored parameters do not read: {e}"),
+        })?;
+        verify_upload::<S>(c, job_id, &params, seed).map(|(_, bytes)| bytes)
+    }
+}
+
+/// The scenes a coordinator runs, by kind.
+#[derive(Clone)]
+pub struct SceneRegistry(Arc<BTreeMap<&'static str, Arc<dyn FarmScene>>>);
+
+/// Makes the [`FarmScene`] of the visited scene.
+struct MakeOps;
+
+impl SceneVisitor for MakeOps {
+    type Output = (&'static str, Arc<dyn FarmScene>);
+    fn visit<S: Scene>(self) -> Self::Output {
+        (S::KIND, Arc::new(Ops::<S>(PhantomData)))
+    }
+}
+
+impl SceneRegistry {
+    /// Every scene of set `Z`.
+    pub fn of<Z: SceneSet>() -> SceneRegistry {
+        SceneRegistry(Arc::new(
+            Z::kinds()
+                .iter()
+                .filter_map(|kind| Z::visit(kind, MakeOps))
+                .collect(),
+        ))
+    }
+
+    /// The scene stored as `kind`; an internal error for one this coordinator does not run
+    /// (a database written by a build with more scenes).
+    pub fn get(&self, kind: &str) -> Result<&dyn FarmScene> {
+        self.0.get(kind).map(|s| &**s).ok_or_else(|| {
+            Error::Internal(format!(
+                "stored scene {kind:?} is not one this coordinator runs"
+            ))
+        })
+    }
+}
+
+impl Default for SceneRegistry {
+    fn default() -> Self {
+        SceneRegistry::of::<grit_erosion::Scenes>()
+    }
+}
