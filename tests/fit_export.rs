@@ -265,7 +265,7 @@ fn every_format_reevaluates_to_grit_fit_eval() {
     let entry = std::fs::read_to_string(of.join("cloudProperties.gritOkaErosion")).unwrap();
     assert!(entry.contains("type    gritOkaErosion;") && entry.contains("patches (walls);"));
     let p = |n: &str| number(&entry, n);
-    let coeffs = ["E90", "Hv", "n1", "n2", "k2", "k3", "vRef", "dRef"].map(|n| p(n));
+    let coeffs = ["E90", "Hv", "n1", "n2", "k2", "k3", "vRef", "dRef"].map(p);
     for (&(a, vv, dd), e) in points.iter().zip(&expected) {
         let s = a.to_radians().sin();
         let got = coeffs[0]

@@ -467,7 +467,8 @@ pub fn export(doc: &FitDocument, format: Format, wall: &str) -> Result<Vec<Expor
             });
         }
     }
-    if !(doc.fit.model.e90_ref > 0.0) || doc.fit.cells.is_empty() {
+    let e90 = doc.fit.model.e90_ref;
+    if !(e90.is_finite() && e90 > 0.0) || doc.fit.cells.is_empty() {
         return Err(FitError::Invalid {
             field: "fit".into(),
             rule: "needs E90 > 0 and the cells it was fitted to".into(),
