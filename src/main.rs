@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use cli::{bench, campaign, jet, plot, sample, serve, study, version};
+use cli::{bench, campaign, fit, jet, plot, sample, serve, study, version};
 
 /// Solid particle erosion predicted by SPH impact simulations.
 #[derive(Parser)]
@@ -56,6 +56,17 @@ enum Command {
         after_help = "Example: grit compare docs/erosion/reduced-results.json docs/erosion/resolution24-results.json"
     )]
     Compare(plot::CompareArgs),
+    /// Fit the full Oka model E(α, v, d) = E90,ref g(α) (v/v_ref)^k2 (d/d_ref)^k3 jointly to
+    /// every steady cell of the results files, weighted by their standard errors: parameters
+    /// with standard errors beside Oka's, χ²/dof and each cell's residual.
+    #[command(
+        after_help = "Example: grit fit velocity/results.json size/results.json -o fit.json --eval 45,100,250e-6"
+    )]
+    Fit(fit::FitArgs),
+    /// Write a fit from `grit fit -o` for a CFD or DEM code: Fluent's generic or Oka erosion
+    /// model, an OpenFOAM cloud function object, EDEM's Oka wear model, or JSON.
+    #[command(after_help = "Example: grit export fit.json --format fluent-oka -o oka.py")]
+    Export(fit::ExportArgs),
     /// Run the coordinator: REST API under /api/v1 on a SQLite database.
     #[command(
         after_help = "Example: GRIT_SUBMIT_TOKEN=s3cret GRIT_WORKER_TOKEN=w0rker grit serve --db grit.db --listen 0.0.0.0:8080"
@@ -111,6 +122,8 @@ fn main() -> ExitCode {
         Command::Study(a) => study::study(a),
         Command::Plot(a) => plot::run(a),
         Command::Compare(a) => plot::compare(a),
+        Command::Fit(a) => fit::fit(a),
+        Command::Export(a) => fit::export_cmd(a),
         Command::Bench(a) => bench::run(a),
         Command::Version(a) => version::run(a),
         Command::Serve(a) => farm("info", serve::serve(a)),

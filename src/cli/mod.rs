@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod campaign;
+pub mod fit;
 pub mod jet;
 pub mod output;
 pub mod plot;
