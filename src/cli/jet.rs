@@ -23,7 +23,7 @@ pub struct JetArgs {
     /// flags below override it.
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
-    /// Target material: copper, al6061 or aisi304.
+    /// Target material: copper, al6061, aisi304, or a JH-2 rock: sandstone or granite.
     #[arg(long)]
     material: Option<String>,
     /// Jet speed at the nozzle (m/s).

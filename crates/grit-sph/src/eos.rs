@@ -8,16 +8,18 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::InputError;
+use crate::jh2::PolynomialEos;
 
 /// Which pressure law a material follows; the default linear law is `p = K (ρ/ρ0 − 1)` (seed eq. 11).
 ///
-/// Kept an enum so a brittle model's polynomial EOS (JH-2, docs/jet.md#open-points) is one
-/// more variant.
+/// The brittle model's polynomial EOS (JH-2, AWJ paper eqs. 40–41) is the second variant.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum EquationOfState {
     /// Shock Mie–Grüneisen EOS (docs/jet.md#equations-of-state).
     MieGruneisen(MieGruneisen),
+    /// JH-2 polynomial EOS, K1 μ + K2 μ² + K3 μ³ (AWJ paper eq. 40; docs/jet.md#rock-targets).
+    Polynomial(PolynomialEos),
 }
 
 impl EquationOfState {
@@ -26,6 +28,9 @@ impl EquationOfState {
     pub fn pressure(&self, rho: f64, e: f64) -> f64 {
         match self {
             EquationOfState::MieGruneisen(g) => g.pressure(rho, e),
+            // The polynomial reads no energy; its bulking pressure is the particle's, added by
+            // the engine (`jh2::pressure_of`).
+            EquationOfState::Polynomial(q) => q.pressure(rho, 0.0),
         }
     }
 
@@ -33,6 +38,7 @@ impl EquationOfState {
     pub fn bulk_modulus(&self) -> f64 {
         match self {
             EquationOfState::MieGruneisen(g) => g.bulk_modulus(),
+            EquationOfState::Polynomial(q) => q.bulk_modulus(),
         }
     }
 
@@ -40,6 +46,7 @@ impl EquationOfState {
     pub fn singular_compression(&self) -> f64 {
         match self {
             EquationOfState::MieGruneisen(g) => g.singular_compression(),
+            EquationOfState::Polynomial(_) => f64::INFINITY,
         }
     }
 
@@ -47,6 +54,7 @@ impl EquationOfState {
     pub fn reference_density(&self) -> f64 {
         match self {
             EquationOfState::MieGruneisen(g) => g.rho0_kg_m3,
+            EquationOfState::Polynomial(q) => q.rho0_kg_m3,
         }
     }
 
@@ -54,7 +62,14 @@ impl EquationOfState {
     pub fn validate(&self, field: &str) -> Result<(), InputError> {
         match self {
             EquationOfState::MieGruneisen(g) => g.validate(field),
+            EquationOfState::Polynomial(q) => q.validate(field),
         }
+    }
+
+    /// Whether the law reads the specific internal energy e (Mie–Grüneisen's Γ ρ0 e), so the
+    /// solid integrates one (docs/jet.md#energy); the polynomial EOS does not.
+    pub fn reads_energy(&self) -> bool {
+        matches!(self, EquationOfState::MieGruneisen(_))
     }
 }
 

@@ -7,11 +7,14 @@
 pub mod eos;
 pub mod error;
 pub mod fluid;
+pub mod jh2;
 pub mod material;
+pub mod rock;
 
 pub use eos::{EquationOfState, MieGruneisen};
 pub use error::{InputError, SimError};
 pub use fluid::{Fluid, FLUID_NAMES};
+pub use jh2::{Jh2Damage, Jh2Laws, Jh2Strength, PolynomialEos};
 pub use material::{Fracture, JohnsonCook, JohnsonCookDamage, Material, Strength, MATERIAL_NAMES};
 pub mod body;
 pub mod contact;

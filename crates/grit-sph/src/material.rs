@@ -1,15 +1,17 @@
 //! Elastic–plastic material data: linear elasticity, Johnson–Cook strength (eq. 18) and
 //! Johnson–Cook fracture (eqs. 19–20) of the seed paper; AISI 304 of its Table 1 is the default.
 //! The water-jet scene's metals (OFHC copper, Al 6061-T6) add a Mie–Grüneisen EOS
-//! (docs/jet.md#metal-targets).
+//! (docs/jet.md#metal-targets); its rocks (red sandstone, granite, `rock.rs`) are JH-2 solids
+//! (AWJ paper eqs. 38–41, docs/jet.md#rock-targets).
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::eos::{EquationOfState, MieGruneisen};
 use crate::error::InputError;
+use crate::jh2::{Jh2Damage, Jh2Laws, Jh2Strength};
 
 /// Names [`Material::by_name`] knows, in the order error messages list them.
-pub const MATERIAL_NAMES: [&str; 3] = ["aisi304", "copper", "al6061"];
+pub const MATERIAL_NAMES: [&str; 5] = ["aisi304", "copper", "al6061", "sandstone", "granite"];
 
 /// Johnson–Cook metal with linear elasticity (seed Table 1 field meanings), SI units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,13 +64,15 @@ pub struct JohnsonCook {
     pub t_melt_k: f64,
 }
 
-/// A strength law: how the deviatoric stress yields (seed eq. 18). An enum so that a brittle
-/// law (JH-2 for rock, docs/jet.md#open-points) can sit beside Johnson–Cook; in JSON it is
-/// the law's parameters alone, as before there was a choice.
+/// A strength law: how the deviatoric stress yields: Johnson–Cook (seed eq. 18) or JH-2 (AWJ
+/// paper eq. 38). In JSON it is the law's parameters alone, as before there was a choice; a
+/// reader tells them apart by JH-2's `hel_pa`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Strength {
     /// Johnson–Cook (seed eq. 18).
     JohnsonCook(JohnsonCook),
+    /// Johnson–Holmquist JH-2 (AWJ paper eq. 38).
+    JohnsonHolmquist2(Jh2Strength),
 }
 
 impl Strength {
@@ -76,6 +80,7 @@ impl Strength {
     pub fn johnson_cook(&self) -> Option<&JohnsonCook> {
         match self {
             Strength::JohnsonCook(jc) => Some(jc),
+            Strength::JohnsonHolmquist2(_) => None,
         }
     }
 }
@@ -84,22 +89,56 @@ impl Serialize for Strength {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
             Strength::JohnsonCook(jc) => jc.serialize(s),
+            Strength::JohnsonHolmquist2(j) => j.serialize(s),
         }
+    }
+}
+
+/// Reads one of two laws written as their parameters alone: `B` where the JSON object has the
+/// key `marker`, else `A`. Materials are only ever stored as JSON (a sample checkpoint keeps its
+/// scene as JSON text), so a format that cannot be looked into reads `A`, the law it always read.
+fn either<'de, D, A, B, T>(
+    d: D,
+    marker: &str,
+    a: impl FnOnce(A) -> T,
+    b: impl FnOnce(B) -> T,
+) -> Result<T, D::Error>
+where
+    D: Deserializer<'de>,
+    A: serde::de::DeserializeOwned,
+    B: serde::de::DeserializeOwned,
+{
+    use serde::de::Error;
+    if !d.is_human_readable() {
+        return A::deserialize(d).map(a);
+    }
+    let v = serde_json::Value::deserialize(d)?;
+    if v.get(marker).is_some() {
+        serde_json::from_value(v).map(b).map_err(D::Error::custom)
+    } else {
+        serde_json::from_value(v).map(a).map_err(D::Error::custom)
     }
 }
 
 impl<'de> Deserialize<'de> for Strength {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        JohnsonCook::deserialize(d).map(Strength::JohnsonCook)
+        either(
+            d,
+            "hel_pa",
+            Strength::JohnsonCook,
+            Strength::JohnsonHolmquist2,
+        )
     }
 }
 
-/// A fracture law: the strain at which damage reaches 1 (seed eqs. 19–20); an enum for the
-/// same reason as [`Strength`], written in JSON as the law's parameters alone.
+/// A fracture law: the strain at which damage reaches 1: Johnson–Cook (seed eqs. 19–20) or JH-2
+/// (AWJ paper eq. 39); written in JSON as the law's parameters alone, JH-2 told by `ef_min`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Fracture {
     /// Johnson–Cook (seed eqs. 19–20).
     JohnsonCook(JohnsonCookDamage),
+    /// Johnson–Holmquist JH-2 (AWJ paper eq. 39).
+    JohnsonHolmquist2(Jh2Damage),
 }
 
 impl Fracture {
@@ -107,6 +146,7 @@ impl Fracture {
     pub fn johnson_cook(&self) -> Option<&JohnsonCookDamage> {
         match self {
             Fracture::JohnsonCook(d) => Some(d),
+            Fracture::JohnsonHolmquist2(_) => None,
         }
     }
 }
@@ -115,13 +155,19 @@ impl Serialize for Fracture {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
             Fracture::JohnsonCook(d) => d.serialize(s),
+            Fracture::JohnsonHolmquist2(d) => d.serialize(s),
         }
     }
 }
 
 impl<'de> Deserialize<'de> for Fracture {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        JohnsonCookDamage::deserialize(d).map(Fracture::JohnsonCook)
+        either(
+            d,
+            "ef_min",
+            Fracture::JohnsonCook,
+            Fracture::JohnsonHolmquist2,
+        )
     }
 }
 
@@ -259,6 +305,8 @@ impl Material {
             "aisi304" => Ok(Self::aisi304()),
             "copper" => Ok(Self::copper()),
             "al6061" => Ok(Self::al6061()),
+            "sandstone" => Ok(Self::sandstone()),
+            "granite" => Ok(Self::granite()),
             _ => Err(InputError::new(
                 "material",
                 format!(
@@ -305,6 +353,30 @@ impl Material {
     pub fn sound_speed(&self) -> f64 {
         ((self.pressure_bulk_modulus() + 4.0 / 3.0 * self.shear_modulus()) / self.density_kg_m3)
             .sqrt()
+    }
+
+    /// The material's three JH-2 laws, when it is a JH-2 solid (strength, damage and a
+    /// polynomial EOS together; `validate` refuses a partial set).
+    pub fn jh2(&self) -> Option<Jh2Laws> {
+        match (&self.plasticity, &self.damage, &self.eos) {
+            (
+                Some(Strength::JohnsonHolmquist2(strength)),
+                Some(Fracture::JohnsonHolmquist2(damage)),
+                Some(EquationOfState::Polynomial(eos)),
+            ) => Some(Jh2Laws {
+                strength: *strength,
+                damage: *damage,
+                eos: *eos,
+            }),
+            _ => None,
+        }
+    }
+
+    /// Whether any of the material's laws is a JH-2 one.
+    pub fn is_jh2(&self) -> bool {
+        matches!(self.plasticity, Some(Strength::JohnsonHolmquist2(_)))
+            || matches!(self.damage, Some(Fracture::JohnsonHolmquist2(_)))
+            || matches!(self.eos, Some(EquationOfState::Polynomial(_)))
     }
 
     /// Checks every field is physical; the error names the field and the rule.
@@ -357,6 +429,21 @@ impl Material {
                     "material.plasticity.t_melt_k",
                     format!("must exceed t_ref_k ({}), got {}", jc.t_ref_k, jc.t_melt_k),
                 ));
+            }
+        }
+        if self.is_jh2() {
+            if self.jh2().is_none() {
+                return Err(InputError::new(
+                    "material.plasticity",
+                    "a JH-2 solid needs all three of its laws: JH-2 plasticity (hel_pa...), JH-2 \
+                     damage (ef_min...) and the polynomial eos (kind \"polynomial\")",
+                ));
+            }
+            if let Some(Strength::JohnsonHolmquist2(s)) = &self.plasticity {
+                s.validate("material.plasticity")?;
+            }
+            if let Some(Fracture::JohnsonHolmquist2(d)) = &self.damage {
+                d.validate("material.damage")?;
             }
         }
         if let Some(Fracture::JohnsonCook(d)) = &self.damage {

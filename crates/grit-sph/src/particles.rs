@@ -42,8 +42,13 @@ pub struct Particles {
     /// as an empty array while all zero, and read back as zeros then ([`deserialize_filled`]).
     #[serde(default, serialize_with = "zeros_as_empty")]
     pub energy: Vec<f64>,
-    /// Johnson–Cook damage D (eq. 19).
+    /// Damage D: Johnson–Cook (eq. 19) or JH-2 (AWJ paper eq. 39).
     pub damage: Vec<f64>,
+    /// JH-2 bulking pressure ΔP (Pa, AWJ paper eq. 41); 0 for every other material. Kept out of
+    /// this type's serde layout, which positional checkpoints read (version 5 and 6 samples):
+    /// a world's state stores it on its own (`WorldState`), and a read fills zeros.
+    #[serde(skip)]
+    pub bulking: Vec<f64>,
     /// Deformation gradient since the reference configuration (hourglass stiffness, eq. 16).
     pub def_grad: Vec<Matrix>,
     /// Reference position for the hourglass stiffness term (m).
@@ -91,6 +96,7 @@ impl Particles {
             temp: gather(&self.temp, order),
             energy: gather(&self.energy, order),
             damage: gather(&self.damage, order),
+            bulking: gather(&self.bulking, order),
             def_grad: gather(&self.def_grad, order),
             x_ref: gather(&self.x_ref, order),
             local: gather(&self.local, order),
@@ -118,6 +124,7 @@ impl Particles {
         self.temp.append(&mut other.temp);
         self.energy.append(&mut other.energy);
         self.damage.append(&mut other.damage);
+        self.bulking.append(&mut other.bulking);
         self.def_grad.append(&mut other.def_grad);
         self.x_ref.append(&mut other.x_ref);
         self.local.append(&mut other.local);
@@ -140,6 +147,7 @@ impl Particles {
             self.temp.len(),
             self.energy.len(),
             self.damage.len(),
+            self.bulking.len(),
             self.def_grad.len(),
             self.x_ref.len(),
             self.local.len(),
@@ -267,6 +275,7 @@ impl Particles {
             temp: state.temp,
             energy: state.energy,
             damage: state.damage,
+            bulking: vec![0.0; n],
             def_grad: state.def_grad,
             x_ref: state.x_ref,
             local: state.local,
@@ -315,6 +324,7 @@ pub fn deserialize_filled<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Part
     if p.energy.is_empty() {
         p.energy = vec![0.0; p.id.len()];
     }
+    p.bulking = vec![0.0; p.id.len()];
     Ok(p)
 }
 

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use grit_sph::verification::{
-    elastic_impact, hertz, hourglass, jet, jet_grain, sliding, slope, CaseReport, Row,
+    elastic_impact, hertz, hourglass, jet, jet_grain, rock, sliding, slope, CaseReport, Row,
 };
 
 use crate::cli::output::say;
@@ -28,7 +28,7 @@ pub struct Args {
     #[arg(long)]
     charts: Option<PathBuf>,
     /// Run only the cases whose name contains this text, case-insensitive: a group (slope,
-    /// sliding, hertz, impact, hourglass, jet) runs alone; any other text runs every group and
+    /// sliding, hertz, impact, hourglass, jet, rock) runs alone; any other text runs every group and
     /// keeps the rows whose case holds it (e.g. hydrostatic).
     #[arg(long)]
     only: Option<String>,
@@ -36,7 +36,7 @@ pub struct Args {
 
 /// How each group's case names begin (`docs/verification.md`), so `--only` can pick the
 /// group of a case without running the others.
-const CASE_NAMES: [(&str, &[&str]); 6] = [
+const CASE_NAMES: [(&str, &[&str]); 7] = [
     ("slope", &["slope_slider"]),
     ("sliding", &["controlled_sliding"]),
     ("hertz", &["hertz"]),
@@ -53,6 +53,17 @@ const CASE_NAMES: [(&str, &[&str]); 6] = [
             "jet_coupling",
             "jet_wall",
             "jet_rc",
+        ],
+    ),
+    (
+        "rock",
+        &[
+            "rock_strength",
+            "rock_uniaxial",
+            "rock_tensile",
+            "rock_hugoniot",
+            "rock_bulking",
+            "rock_spall",
         ],
     ),
 ];
@@ -82,10 +93,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let wall = if a.quick { (16, 400.0) } else { (24, 400.0) };
     // The coupling-radius study's jet: the paper's d_ini = 50 µm is 20 across its 1 mm jet.
     let rc = jet_grain::RcScene::new(if a.quick { 16 } else { 20 }, 500.0, 1.0);
+    // The spall block's particles along its length (half as many across).
+    let rock_n = if a.quick { 24 } else { 40 };
     let only = a.only.as_deref().map(str::to_lowercase);
     let want = |name: &str| only.as_deref().is_none_or(|o| name.contains(o));
     let mut rep = CaseReport::default();
-    let cases: [(&str, Case); 6] = [
+    let cases: [(&str, Case); 7] = [
         ("slope", Box::new(move || slope::run(slope_n))),
         ("sliding", Box::new(move || sliding::run(slide_n))),
         ("hertz", Box::new(move || hertz::run(hertz_n))),
@@ -95,6 +108,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "jet",
             Box::new(move || jet::run(jet_dt, jet_n, jet_settle, wall, rc)),
         ),
+        ("rock", Box::new(move || rock::run(rock_n))),
     ];
     // A text no group's name holds names cases inside the groups (`hydrostatic`,
     // `jet_wall_force`): the groups whose cases can hold it run, and only the rows whose case

@@ -133,7 +133,7 @@ pub(crate) fn particle_state(p: &Particles, bc: &[BodyConst]) -> Vec<(f64, f64)>
                     f.pressure(p.rho[i], EOS_POROSITY),
                     f.sound_speed(p.rho[i], EOS_POROSITY),
                 ),
-                None if c.deformable => (c.pressure(p.rho[i], p.rho0[i], p.energy[i]), c.sound),
+                None if c.deformable => (c.particle_pressure(p, i), c.sound),
                 None => (0.0, 0.0),
             }
         })

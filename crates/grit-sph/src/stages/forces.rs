@@ -56,7 +56,7 @@ pub(crate) fn forces(
             if !c.deformable {
                 return Matrix::zeros();
             }
-            let pr = c.pressure(p.rho[i], p.rho0[i], p.energy[i]);
+            let pr = c.particle_pressure(p, i);
             (p.sdev[i] - Matrix::identity() * pr) / (p.rho[i] * p.rho[i] * sh[i])
         })
         .collect();

@@ -45,6 +45,7 @@ use rayon::iter::{IndexedParallelIterator, MaxLen, MinLen};
 
 use crate::body::Body;
 use crate::eos::EquationOfState;
+use crate::jh2::{self, Jh2Laws};
 use crate::kernel::Kernel;
 use crate::material::Material;
 use crate::neighbours::{HalfIndex, NeighbourLists};
@@ -114,6 +115,8 @@ pub(crate) struct BodyConst {
     pub rho_cap: f64,
     /// The constants of a fluid body (AWJ paper eqs. 21–27); `None` for solids.
     pub fluid: Option<FluidConst>,
+    /// The JH-2 laws of a rock (AWJ paper eqs. 38–41); `None` for every other material.
+    pub jh2: Option<Jh2Laws>,
 }
 
 impl BodyConst {
@@ -128,11 +131,23 @@ impl BodyConst {
         }
     }
 
+    /// The pressure of particle `i` of `p`: [`Self::pressure`], or for a JH-2 rock the
+    /// polynomial EOS with the particle's bulking pressure, never below −T (1 − D) (AWJ paper
+    /// eqs. 40–41, `jh2::pressure_of`).
+    #[inline]
+    pub fn particle_pressure(&self, p: &Particles, i: usize) -> f64 {
+        match &self.jh2 {
+            None => self.pressure(p.rho[i], p.rho0[i], p.energy[i]),
+            Some(l) => jh2::pressure_of(l, p.rho[i], p.bulking[i], p.damage[i]),
+        }
+    }
+
     /// Whether the body's particles integrate an internal energy: a solid whose pressure law
-    /// reads one (Mie–Grüneisen). A fluid stays on its cold curve (docs/jet.md#energy).
+    /// reads one (Mie–Grüneisen). A fluid stays on its cold curve (docs/jet.md#energy), and
+    /// JH-2's polynomial reads none.
     #[inline]
     pub fn has_energy(&self) -> bool {
-        self.deformable && self.eos.is_some()
+        self.deformable && self.eos.is_some_and(|e| e.reads_energy())
     }
 }
 
@@ -150,6 +165,7 @@ impl BodyConst {
                 e.reference_density() * (1.0 + 0.9 * e.singular_compression())
             }),
             fluid: None,
+            jh2: m.jh2(),
         }
     }
 

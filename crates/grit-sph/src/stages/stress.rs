@@ -1,9 +1,11 @@
 //! The stress update: continuity (eq. 5), the Jaumann stress rate (eq. 13), radial return with
-//! Johnson–Cook yield (eq. 18), adiabatic heating and damage (eqs. 19–20).
+//! Johnson–Cook yield (eq. 18), adiabatic heating and damage (eqs. 19–20); or, for rock, the
+//! JH-2 update (AWJ paper eqs. 38–41, `jh2::jh2_update`).
 
 use rayon::prelude::*;
 
 use super::{ParTasks, StepCtx};
+use crate::jh2::{self, Jh2State};
 use crate::material::{Fracture, JohnsonCook, Strength};
 use crate::math::Matrix;
 use crate::particles::von_mises;
@@ -69,7 +71,7 @@ pub(crate) fn stress(ctx: &mut StepCtx<'_>, gv: &[Matrix], memo: &mut Vec<YieldM
         .zip(p.eps_p_rate.par_iter_mut())
         .zip(p.temp.par_iter_mut())
         .zip(p.energy.par_iter())
-        .zip(p.damage.par_iter_mut())
+        .zip(p.damage.par_iter_mut().zip(p.bulking.par_iter_mut()))
         .zip(p.def_grad.par_iter_mut())
         .zip(p.body.par_iter())
         .zip(p.mass.par_iter())
@@ -80,7 +82,13 @@ pub(crate) fn stress(ctx: &mut StepCtx<'_>, gv: &[Matrix], memo: &mut Vec<YieldM
         .map(
             |(
                 i,
-                (((((((((((rho, s), ep), epr), temp), &en), dmg), fdef), &b), &m), &rho0), memo),
+                (
+                    (
+                        (((((((((rho, s), ep), epr), temp), &en), (dmg, bulk)), fdef), &b), &m),
+                        &rho0,
+                    ),
+                    memo,
+                ),
             )| {
                 let c = bc[b as usize];
                 if !c.deformable {
@@ -101,6 +109,27 @@ pub(crate) fn stress(ctx: &mut StepCtx<'_>, gv: &[Matrix], memo: &mut Vec<YieldM
                     None => {
                         *s = s_trial;
                         0.0
+                    }
+                    Some(Strength::JohnsonHolmquist2(_)) => {
+                        let laws = c.jh2.as_ref().expect("a JH-2 strength has all three laws");
+                        let st = Jh2State {
+                            sdev: s_trial,
+                            eps_p: *ep,
+                            damage: *dmg,
+                            bulking: *bulk,
+                        };
+                        let rate = jh2::equivalent_rate(&d);
+                        let r = jh2::jh2_update(s_trial, st, *rho, rate, c.shear, laws);
+                        *s = r.state.sdev;
+                        *ep = r.state.eps_p;
+                        *dmg = r.state.damage;
+                        *bulk = r.state.bulking;
+                        *epr = r.d_eps / dt;
+                        let wp = r.sigma_y * r.d_eps;
+                        if wp > 0.0 {
+                            *temp += beta * wp / (*rho * mat.heat_capacity_j_kgk);
+                        }
+                        wp * m / *rho
                     }
                     Some(Strength::JohnsonCook(jc)) => {
                         let at = memo.get(p.id[i], jc, *ep, *temp);

@@ -12,6 +12,7 @@ pub mod hydrostatic;
 pub mod jet;
 pub mod jet_grain;
 pub mod jet_wall;
+pub mod rock;
 pub mod settling;
 pub mod sliding;
 pub mod slope;

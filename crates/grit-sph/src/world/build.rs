@@ -63,6 +63,7 @@ impl World {
         p.temp.push(self.settings.temperature_k);
         p.energy.push(0.0);
         p.damage.push(0.0);
+        p.bulking.push(0.0);
         p.def_grad.push(Matrix::identity());
         p.x_ref.push(x);
         p.local.push(local);

@@ -49,6 +49,11 @@ pub struct WorldState {
     flow: Flow,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     abrasives: Option<Abrasives>,
+    /// The particles' JH-2 bulking pressures (Pa, AWJ paper eq. 41), one per particle; absent
+    /// while all are zero (every world without rock), so those states keep their JSON. Kept
+    /// beside `particles` because `ParticlesState`'s positional layout is pinned.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    bulking_pa: Vec<f64>,
 }
 
 /// The layout a state that names none was written in.
@@ -87,6 +92,11 @@ impl World {
             x_build: self.x_build.clone(),
             flow: self.flow.clone(),
             abrasives: self.abrasives.clone(),
+            bulking_pa: if self.particles.bulking.iter().all(|&b| b == 0.0) {
+                Vec::new()
+            } else {
+                self.particles.bulking.clone()
+            },
         }
     }
 
@@ -103,9 +113,18 @@ impl World {
                 ),
             ));
         }
-        let particles = Particles::from_state(state.particles)
+        let mut particles = Particles::from_state(state.particles)
             .map_err(|e| InputError::new(format!("world.{}", e.field), e.rule))?;
         let (n, bodies) = (particles.len(), state.bodies.len());
+        if !state.bulking_pa.is_empty() {
+            if state.bulking_pa.len() != n {
+                return Err(InputError::new(
+                    "world.bulking_pa",
+                    format!("holds {} values for {n} particles", state.bulking_pa.len()),
+                ));
+            }
+            particles.bulking = state.bulking_pa;
+        }
         if let Some(i) = particles.body.iter().position(|&b| b as usize >= bodies) {
             return Err(InputError::new(
                 format!("world.particles.body[{i}]"),

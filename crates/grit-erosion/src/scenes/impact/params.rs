@@ -376,6 +376,18 @@ impl ImpactParams {
         self.material
             .validate()
             .map_err(|e| InputError::new(format!("material.{}", e.field), e.rule))?;
+        if self.material.is_jh2() {
+            // A sample's checkpoint keeps its surface in a pinned positional layout without the
+            // JH-2 bulking pressure, so a resumed rock sample would not be the uninterrupted one.
+            return Err(InputError::new(
+                "material",
+                format!(
+                    "`{}` is a JH-2 rock, a material of the jet scene (grit jet --material); the \
+                     impact scene takes aisi304, copper or al6061",
+                    self.material.name
+                ),
+            ));
+        }
         let k = self.numerics.contact_stiffness_scale;
         // The stability map spans 0.25 to 256 by default; beyond 1000 is a typo.
         if !(k.is_finite() && k > 0.0 && k <= 1e3) {

@@ -13,7 +13,8 @@ use crate::campaign::MaterialSpec;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct JetParams {
-    /// Target material: a preset name (`copper`, `al6061`, `aisi304`) or a full object.
+    /// Target material: a preset name (`copper`, `al6061`, `aisi304`, `sandstone`, `granite`) or
+    /// a full object.
     pub material: MaterialSpec,
     /// Jet speed v_jet at the nozzle (m/s).
     pub velocity_m_s: f64,
