@@ -3,6 +3,7 @@
 //! named.
 
 use grit_erosion::jet::{grain_spacing_m, JetParams, JetRun};
+use sha2::Digest;
 
 /// A small, fast jet: 6 particles across a 0.6 mm jet, a 3 × 0.8 mm copper target, 0.6 mm
 /// standoff, 4 µs in slices of 1 µs.
@@ -63,11 +64,44 @@ fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
     // Another seed places other grains.
     let other = JetRun::resume(&tiny(), 6, &whole.checkpoint());
     assert!(other.is_err(), "a checkpoint resumed under another seed");
+    // The bytes are the JSON, a newline and the JSON's SHA-256 in hex.
+    let bytes = whole.checkpoint();
+    let cut = bytes.iter().rposition(|&b| b == b'\n').unwrap();
+    let json = &bytes[..cut];
+    let seal = |json: &[u8]| {
+        let mut b = json.to_vec();
+        b.push(b'\n');
+        b.extend_from_slice(format!("{:x}", sha2::Sha256::digest(json)).as_bytes());
+        b
+    };
+    assert_eq!(seal(json), bytes);
+    let refused = |b: &[u8]| JetRun::from_checkpoint(b).err().unwrap().to_string();
+    let mut flipped = bytes.clone();
+    flipped[cut / 2] ^= 0x01;
+    assert!(
+        refused(&flipped).contains("damaged"),
+        "{}",
+        refused(&flipped)
+    );
+    let short = &bytes[..bytes.len() - 10];
+    assert!(refused(short).contains("truncated"), "{}", refused(short));
+    assert!(refused(&bytes[..cut / 2]).contains("cannot decode"));
+    // A checkpoint written before the checksum (version 3, the JSON alone) still resumes.
+    let mut v: serde_json::Value = serde_json::from_slice(json).unwrap();
+    v["version"] = 3.into();
+    let old = JetRun::resume(&tiny(), 5, &serde_json::to_vec(&v).unwrap()).unwrap();
+    assert!(
+        state(&old) == state(&whole),
+        "a version-3 checkpoint reads as it was"
+    );
+    v["version"] = 4.into();
+    let unsealed = refused(&serde_json::to_vec(&v).unwrap());
+    assert!(unsealed.contains("version 4 but"), "{unsealed}");
     // Slices that are not the world's own: dropped, renumbered or one too few.
     let edited = |edit: &dyn Fn(&mut serde_json::Value)| {
-        let mut v: serde_json::Value = serde_json::from_slice(&whole.checkpoint()).unwrap();
+        let mut v: serde_json::Value = serde_json::from_slice(json).unwrap();
         edit(&mut v);
-        JetRun::from_checkpoint(&serde_json::to_vec(&v).unwrap())
+        JetRun::from_checkpoint(&seal(&serde_json::to_vec(&v).unwrap()))
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default()

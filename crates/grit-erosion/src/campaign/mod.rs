@@ -45,6 +45,28 @@ pub const MAX_CELLS: usize = 10_000;
 /// CPU-years at the seed's resolution, a guard against a typo that would fill the database.
 pub const MAX_IMPACTS_TOTAL: u128 = 100_000_000;
 
+/// Cells of a spec whose swept dimensions have lengths `dims` (each list's spec field and
+/// length): their product. Bounded for a validated spec, so it fits.
+pub(crate) fn cell_count(dims: &[(&'static str, usize)]) -> usize {
+    dims.iter().map(|(_, n)| n).product()
+}
+
+/// Per swept dimension of `dims`, fastest first: (spec field, index of cell `cell`'s value,
+/// whether swept), the mixed-radix digits of the cell index.
+pub(crate) fn sweep_indices(
+    dims: &[(&'static str, usize)],
+    cell: u32,
+) -> Vec<(&'static str, usize, bool)> {
+    let mut rest = cell as usize;
+    dims.iter()
+        .map(|&(name, n)| {
+            let i = rest % n.max(1);
+            rest /= n.max(1);
+            (name, i, n > 1)
+        })
+        .collect()
+}
+
 /// The rule on the cell count: at most [`MAX_CELLS`], named on the longest list of `dims`.
 pub(crate) fn check_cells(dims: &[(&'static str, usize)]) -> Result<(), SpecError> {
     let cells = job_count(dims.iter().map(|(_, len)| *len), 1);

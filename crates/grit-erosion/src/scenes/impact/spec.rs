@@ -20,8 +20,9 @@ use super::aggregate::{CellInput, SampleInput};
 use super::params::ImpactParams;
 use crate::campaign::json::{self, field_path, one_or_many, reject_unknown};
 use crate::campaign::{
-    check_cells, check_list_len, check_sweep, err, job_count, job_seed, ImpactPlan, MaterialSpec,
-    Samples, SpecError, Sweep, UntilSteady, MAX_IMPACTS, MAX_IMPACTS_TOTAL, MAX_JOBS, MIN_IMPACTS,
+    cell_count, check_cells, check_list_len, check_sweep, err, job_count, job_seed, sweep_indices,
+    ImpactPlan, MaterialSpec, Samples, SpecError, Sweep, UntilSteady, MAX_IMPACTS,
+    MAX_IMPACTS_TOTAL, MAX_JOBS, MIN_IMPACTS,
 };
 use crate::models::shapes::Shape;
 
@@ -420,23 +421,14 @@ impl CampaignSpec {
         ]
     }
 
-    /// Cells of a validated spec (its job count is bounded, so the product fits).
+    /// Cells of a validated spec.
     fn cell_count(&self) -> usize {
-        self.dims().iter().map(|(_, n)| n).product()
+        cell_count(&self.dims())
     }
 
-    /// Per swept dimension: (spec field, index of this cell's value, whether swept), in the
-    /// mixed-radix digits of the cell index.
+    /// Per swept dimension: (spec field, index of cell `cell`'s value, whether swept).
     fn sweep_indices(&self, cell: u32) -> Vec<(&'static str, usize, bool)> {
-        let mut rest = cell as usize;
-        self.dims()
-            .iter()
-            .map(|(name, n)| {
-                let i = rest % n;
-                rest /= n;
-                (*name, i, *n > 1)
-            })
-            .collect()
+        sweep_indices(&self.dims(), cell)
     }
 
     fn cells_unchecked(&self) -> Vec<Cell> {

@@ -5,6 +5,7 @@ use grit_sph::crater::{self, CraterOptions, CraterSample};
 use grit_sph::world::GrainContacts;
 use grit_sph::{InputError, SimError, Timers, World, WorldState};
 use serde::{Deserialize, Serialize};
+use sha2::Digest;
 
 use super::feed::Feed;
 use super::scene::{self, Layout};
@@ -134,8 +135,10 @@ struct Checkpoint {
     slices: Vec<JetSlice>,
 }
 
-/// Version of the checkpoint layout; a build reads only its own.
-const CHECKPOINT_VERSION: u32 = 3;
+/// Version of the checkpoint layout: the JSON, a newline and the SHA-256 of the JSON in hex.
+const CHECKPOINT_VERSION: u32 = 4;
+/// The layout before checkpoints carried a checksum: the JSON alone, still read.
+const UNCHECKED_VERSION: u32 = 3;
 
 impl JetRun {
     /// A fresh run of `params` whose grains are placed from `seed`.
@@ -314,7 +317,9 @@ impl JetRun {
         })
     }
 
-    /// The state after the last finished slice, as bytes (JSON; floats kept bit for bit).
+    /// The state after the last finished slice, as bytes: JSON (floats kept bit for bit), a
+    /// newline, and the SHA-256 of the JSON in hex (FIPS 180-4), so bytes damaged at rest are
+    /// refused instead of resumed into other numbers.
     pub fn checkpoint(&self) -> Vec<u8> {
         let c = Checkpoint {
             version: CHECKPOINT_VERSION,
@@ -324,7 +329,11 @@ impl JetRun {
             feed: self.feed.clone(),
             slices: self.slices.clone(),
         };
-        serde_json::to_vec(&c).expect("a checkpoint always serialises")
+        let mut bytes = serde_json::to_vec(&c).expect("a checkpoint always serialises");
+        let digest = format!("{:x}", sha2::Sha256::digest(&bytes));
+        bytes.push(b'\n');
+        bytes.extend_from_slice(digest.as_bytes());
+        bytes
     }
 
     /// Goes on from `checkpoint()` bytes; the parameters and seed must be the run's own.
@@ -340,11 +349,36 @@ impl JetRun {
 
     /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them.
     pub fn from_checkpoint(bytes: &[u8]) -> Result<JetRun, JetError> {
-        let c: Checkpoint = serde_json::from_slice(bytes)
-            .map_err(|e| JetError::Checkpoint(format!("cannot decode: {e}")))?;
-        if c.version != CHECKPOINT_VERSION {
-            return Err(JetError::Checkpoint(format!(
-                "version {} but this build reads {CHECKPOINT_VERSION}",
+        let bad = |m: String| JetError::Checkpoint(m);
+        // Compact JSON holds no newline: one separates the checksum of a checked layout.
+        let (body, sum) = match bytes.iter().rposition(|&b| b == b'\n') {
+            Some(i) => (&bytes[..i], Some(&bytes[i + 1..])),
+            None => (bytes, None),
+        };
+        if let Some(sum) = sum {
+            if sum.len() != 64 {
+                return Err(bad(format!(
+                    "truncated: {} of the 64 hex digits of its checksum are there",
+                    sum.len().min(64)
+                )));
+            }
+            if format!("{:x}", sha2::Sha256::digest(body)).as_bytes() != sum {
+                return Err(bad(
+                    "damaged: its bytes do not match their SHA-256 checksum".into(),
+                ));
+            }
+        }
+        let c: Checkpoint =
+            serde_json::from_slice(body).map_err(|e| bad(format!("cannot decode: {e}")))?;
+        let expected = if sum.is_some() {
+            CHECKPOINT_VERSION
+        } else {
+            UNCHECKED_VERSION
+        };
+        if c.version != expected {
+            return Err(bad(format!(
+                "version {} but this build reads {UNCHECKED_VERSION} (no checksum) and \
+                 {CHECKPOINT_VERSION} (with one)",
                 c.version
             )));
         }

@@ -19,8 +19,8 @@ use serde_json::{Map, Value};
 
 use crate::campaign::json::{self, count, field_path, reject_unknown};
 use crate::campaign::{
-    check_cells, check_list_len, check_sweep, err, job_count, job_seed, MaterialSpec, SpecError,
-    Sweep, MAX_JOBS,
+    cell_count, check_cells, check_list_len, check_sweep, err, job_count, job_seed, sweep_indices,
+    MaterialSpec, SpecError, Sweep, MAX_JOBS,
 };
 use crate::jet::JetParams;
 
@@ -255,23 +255,14 @@ impl JetCampaignSpec {
         ]
     }
 
-    /// Cells of a validated spec (its job count is bounded, so the product fits).
+    /// Cells of a validated spec.
     fn cell_count(&self) -> usize {
-        self.dims().iter().map(|(_, n)| n).product()
+        cell_count(&self.dims())
     }
 
-    /// Per swept dimension, fastest first: (spec field, index of this cell's value, whether
-    /// swept); the mixed-radix digits of the cell index.
+    /// Per swept dimension: (spec field, index of cell `cell`'s value, whether swept).
     fn sweep_indices(&self, cell: u32) -> Vec<(&'static str, usize, bool)> {
-        let mut rest = cell as usize;
-        self.dims()
-            .iter()
-            .map(|&(name, n)| {
-                let i = rest % n.max(1);
-                rest /= n.max(1);
-                (name, i, n > 1)
-            })
-            .collect()
+        sweep_indices(&self.dims(), cell)
     }
 
     /// Checks every rule; the error names the field and the rule.
