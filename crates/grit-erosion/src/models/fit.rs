@@ -31,6 +31,25 @@ pub fn oka_silica_k2(hv_gpa: f64) -> f64 {
 /// Oka's size exponent for silica grains, k3 = 0.19 (Oka & Yoshida 2005, Table 2).
 pub const OKA_SILICA_K3: f64 = 0.19;
 
+/// Oka's reference-erosion constant for silica grains, K = 65 mm³ of target per kg of grains
+/// (Oka & Yoshida 2005, Table 2).
+pub const OKA_SILICA_K_MM3_PER_KG: f64 = 65.0;
+
+/// Oka's hardness exponent of E90 for silica grains, k1 = −0.12 (Oka & Yoshida 2005, Table 2).
+pub const OKA_SILICA_K1: f64 = -0.12;
+
+/// Oka's predicted normal-impact erosion of a target of hardness `hv_gpa` (GPa, taken as a
+/// number) and density `density_kg_m3` by silica grains of diameter `d_m` at `v_m_s`, as mass
+/// lost per mass of grains: E90 = K Hv^k1 (v/V′)^k2 (d/D′)^k3 (Oka & Yoshida 2005, eq. 4,
+/// Table 2), the volume turned into mass with the target's density.
+pub fn oka_silica_e90(hv_gpa: f64, density_kg_m3: f64, v_m_s: f64, d_m: f64) -> f64 {
+    let mm3_per_kg = OKA_SILICA_K_MM3_PER_KG
+        * hv_gpa.powf(OKA_SILICA_K1)
+        * (v_m_s / OKA_V_REF_M_S).powf(oka_silica_k2(hv_gpa))
+        * (d_m / OKA_D_REF_M).powf(OKA_SILICA_K3);
+    mm3_per_kg * 1e-9 * density_kg_m3
+}
+
 /// A parameter of the full Oka model (Oka & Yoshida 2005 eq. 4; seed eqs. 35, 38).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

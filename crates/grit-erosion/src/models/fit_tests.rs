@@ -357,3 +357,14 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn okas_silica_e90_for_aisi_304_at_the_seeds_impact() {
+    // By hand: 65 mm³/kg × 1.8^−0.12 (0.93190) × (100/104)^2.35195 (0.91184)
+    // × (250/326)^0.19 (0.95082) = 52.52 mm³/kg; × 7890 kg/m³ = 4.1438e-4 kg/kg.
+    let e90 = oka_silica_e90(1.8, 7890.0, 100.0, 250e-6);
+    assert!((e90 - 4.1438e-4).abs() < 2e-7, "{e90:e}");
+    // At Oka's own reference speed and size only the constant and the hardness remain.
+    let at_ref = oka_silica_e90(1.0, 1e9, OKA_V_REF_M_S, OKA_D_REF_M);
+    assert!((at_ref - 65.0).abs() < 1e-9, "{at_ref}");
+}
