@@ -66,15 +66,15 @@ pub struct ServeArgs {
 pub struct WorkArgs {
     #[command(flatten)]
     pub remote: Remote,
-    /// Engine threads (rayon pool size) of each job; default all cores with one job, one
-    /// thread each with several.
+    /// Engine threads (rayon pool size) of each job; default one (all cores with `--jobs 1`).
     #[arg(long, env = "GRIT_THREADS", value_parser = crate::cli::thread_count)]
     pub threads: Option<usize>,
-    /// Jobs this process holds at once, each on its own lease and engine pool, so one process
-    /// serves all of a machine's cores (a farm's throughput is one job per core:
-    /// docs/performance.md); reported to the coordinator as NAME/1 … NAME/N.
-    #[arg(long, default_value_t = 1, env = "GRIT_JOBS", value_parser = crate::cli::thread_count)]
-    pub jobs: usize,
+    /// Jobs this process holds at once, each on its own lease and engine pool, reported to the
+    /// coordinator as NAME/1 … NAME/N. Default: the machine's cores divided by `--threads`, so
+    /// one process serves all of a machine's cores with one job per core (a farm's throughput
+    /// is one job per core: docs/performance.md).
+    #[arg(long, env = "GRIT_JOBS", value_parser = crate::cli::thread_count)]
+    pub jobs: Option<usize>,
     /// Upload a checkpoint every this many impacts.
     #[arg(long, default_value_t = 5, value_parser = crate::cli::at_least_one)]
     pub checkpoint_every: u32,
@@ -152,16 +152,20 @@ pub async fn work(a: WorkArgs) -> anyhow::Result<ExitCode> {
         Duration::from_secs_f64(a.request_timeout_s),
     )?;
     let name = a.name.unwrap_or_else(worker::default_name);
-    // With several jobs each gets one engine thread unless told otherwise: samples are
-    // independent and parallelise better than the threads inside one impact.
-    let threads = a.threads.or((a.jobs > 1).then_some(1));
+    // Samples are independent and parallelise better than the threads inside one impact, so
+    // by default every core runs a job of its own on one engine thread.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = a
+        .jobs
+        .unwrap_or_else(|| (cores / a.threads.unwrap_or(1)).max(1));
+    let threads = a.threads.or((jobs > 1).then_some(1));
     let stop = Stop::default();
     on_signals(stop.clone());
-    tracing::info!(coordinator = %client.base(), %name, jobs = a.jobs, "worker started");
-    let loops: Vec<_> = (1..=a.jobs)
+    tracing::info!(coordinator = %client.base(), %name, jobs = jobs, "worker started");
+    let loops: Vec<_> = (1..=jobs)
         .map(|k| {
             let opts = WorkerOptions {
-                name: if a.jobs > 1 {
+                name: if jobs > 1 {
                     format!("{name}/{k}")
                 } else {
                     name.clone()
