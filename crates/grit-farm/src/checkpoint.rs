@@ -231,19 +231,11 @@ mod tests {
         assert_eq!(kept.sha256, c.sha256);
     }
 
-    /// The lead's small jet scene (crates/grit-erosion/tests/jet.rs), one slice of 1 µs.
+    /// The small jet scene, one slice of 1 µs.
     fn tiny_jet() -> JetParams {
         JetParams {
-            spacing_m: 1e-4,
-            jet_width_m: 6e-4,
-            target_width_m: 3e-3,
-            target_depth_m: 8e-4,
-            standoff_m: 6e-4,
-            grain_diameter_m: 2e-4,
-            mass_flow_kg_s: 0.01,
             time_ms: 0.002,
-            slice_ms: 0.001,
-            ..JetParams::default()
+            ..JetParams::small()
         }
     }
 

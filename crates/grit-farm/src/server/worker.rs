@@ -79,6 +79,22 @@ impl Report {
         Ok((reported, Some(bytes)))
     }
 
+    /// A heartbeat, complete or release body for job `raw` (which takes no `error`): the job
+    /// id, lease, and the units and checkpoint checked by [`Report::checked`].
+    async fn without_error(
+        mut self,
+        s: &AppState,
+        raw: &str,
+        endpoint: &str,
+    ) -> Result<(i64, Uuid, Reported, Option<CheckpointBytes>)> {
+        let job = job_id(raw)?;
+        if self.error.is_some() {
+            return Err(Report::refuse("error", endpoint));
+        }
+        let (units, checkpoint) = self.checked(s, job).await?;
+        Ok((job, self.lease_id, units, checkpoint))
+    }
+
     /// The 422 for a field the endpoint does not take.
     fn refuse(field: &str, endpoint: &str) -> Error {
         Error::invalid(field, format!("unknown field for {endpoint}"))
@@ -202,17 +218,11 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
 async fn heartbeat(
     State(s): State<AppState>,
     Path(job): Path<String>,
-    ApiJson(mut req): ApiJson<Report>,
+    ApiJson(req): ApiJson<Report>,
 ) -> Result<Json<HeartbeatResponse>> {
-    let job = job_id(&job)?;
-    if req.error.is_some() {
-        return Err(Report::refuse("error", "heartbeat"));
-    }
-    let (units, checkpoint) = req.checked(&s, job).await?;
+    let (job, lease, units, checkpoint) = req.without_error(&s, &job, "heartbeat").await?;
     Ok(Json(
-        s.store
-            .heartbeat(job, req.lease_id, units, checkpoint)
-            .await?,
+        s.store.heartbeat(job, lease, units, checkpoint).await?,
     ))
 }
 
@@ -224,16 +234,10 @@ async fn heartbeat(
 async fn complete(
     State(s): State<AppState>,
     Path(job): Path<String>,
-    ApiJson(mut req): ApiJson<Report>,
+    ApiJson(req): ApiJson<Report>,
 ) -> Result<StatusCode> {
-    let job = job_id(&job)?;
-    if req.error.is_some() {
-        return Err(Report::refuse("error", "complete"));
-    }
-    let (units, checkpoint) = req.checked(&s, job).await?;
-    s.store
-        .complete(job, req.lease_id, units, checkpoint)
-        .await?;
+    let (job, lease, units, checkpoint) = req.without_error(&s, &job, "complete").await?;
+    s.store.complete(job, lease, units, checkpoint).await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
@@ -270,15 +274,9 @@ async fn fail(
 async fn release(
     State(s): State<AppState>,
     Path(job): Path<String>,
-    ApiJson(mut req): ApiJson<Report>,
+    ApiJson(req): ApiJson<Report>,
 ) -> Result<StatusCode> {
-    let job = job_id(&job)?;
-    if req.error.is_some() {
-        return Err(Report::refuse("error", "release"));
-    }
-    let (units, checkpoint) = req.checked(&s, job).await?;
-    s.store
-        .release(job, req.lease_id, units, checkpoint)
-        .await?;
+    let (job, lease, units, checkpoint) = req.without_error(&s, &job, "release").await?;
+    s.store.release(job, lease, units, checkpoint).await?;
     Ok(StatusCode::NO_CONTENT)
 }
