@@ -31,18 +31,14 @@ pub fn canonical_impact() -> ImpactParams {
     }
 }
 
-/// The jet of the jet fingerprint: the default copper scene shrunk to a 3 × 1.2 mm target
-/// 1 mm below the nozzle at Δx = 100 µm, for 5 µs: the water and its grains reach and dent the
-/// target within the run.
+/// The jet of the jet fingerprint: the small jet ([`JetParams::small`]: a 3 × 0.8 mm copper
+/// target 0.6 mm below a 0.6 mm nozzle at Δx = 100 µm) for one slice of 3 µs: the water and its
+/// grains reach and dent the target within the run.
 pub fn canonical_jet() -> JetParams {
     JetParams {
-        spacing_m: 1e-4,
-        time_ms: 0.005,
-        slice_ms: 0.005,
-        standoff_m: 1e-3,
-        target_width_m: 3e-3,
-        target_depth_m: 1.2e-3,
-        ..JetParams::default()
+        time_ms: 0.003,
+        slice_ms: 0.003,
+        ..JetParams::small()
     }
 }
 
