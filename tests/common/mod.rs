@@ -128,7 +128,11 @@ pub fn start_worker(dir: &Path, url: &str, name: &str, args: &[&str]) -> Proc {
         .args(["work", "--coordinator", url, "--token", WORKER])
         .args(["--threads", "1", "--poll-s", "0.2", "--name", name])
         // One job per process unless the test asks for more, whatever the machine's cores.
-        .args(if args.contains(&"--jobs") { &[][..] } else { &["--jobs", "1"][..] })
+        .args(if args.contains(&"--jobs") {
+            &[][..]
+        } else {
+            &["--jobs", "1"][..]
+        })
         .args(args)
         .env("RUST_LOG", "info")
         .stdout(Stdio::null())
