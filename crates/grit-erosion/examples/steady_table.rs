@@ -8,12 +8,13 @@
 use std::process::ExitCode;
 
 use grit_erosion::impact::aggregate::CampaignResults;
-use grit_erosion::impact::steady::{reassess, SteadyState};
+use grit_erosion::impact::steady::reassess;
 use grit_erosion::stats::SlopeFit;
 
-/// The slopes' difference in combined standard errors, the quantity of condition 1.
-fn z(s: &SteadyState) -> String {
-    match (s.slope_last, s.slope_prev) {
+/// Two adjacent slopes' difference (later minus earlier) in combined standard errors, the
+/// quantity of condition 1.
+fn z(a: Option<SlopeFit>, b: Option<SlopeFit>) -> String {
+    match (a, b) {
         (Some(a), Some(b)) if a.sem.hypot(b.sem) > 0.0 => {
             format!("{:+.1}", (a.value - b.value) / a.sem.hypot(b.sem))
         }
@@ -41,24 +42,29 @@ fn run(path: &str) -> Result<(), String> {
         serde_json::from_str(&text).map_err(|e| format!("{path}: {e}"))?;
     println!("\n{path}\n");
     println!(
-        "| cell | samples | impacts | last 20 (mg/g) | previous 20 (mg/g) | difference (combined s.e.) \
-         | sees changes of | steady (stored rule) | steady (this rule) |"
+        "| cell | samples | impacts | last 20 (mg/g) | previous 20 (mg/g) | the 20 before (mg/g) \
+         | differences (combined s.e.) | sees changes of | steady (stored rule) | steady (this rule) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for c in &stored.cells {
         let now = reassess(c);
-        let (last, prev, zz, sees) = match now.as_ref().map(|r| &r.state) {
+        let (last, prev, before, zz, sees) = match now.as_ref().map(|r| &r.state) {
             Some(s) => (
                 show(s.slope_last),
                 show(s.slope_prev),
-                z(s),
+                show(s.slope_before),
+                format!(
+                    "{}, {}",
+                    z(s.slope_last, s.slope_prev),
+                    z(s.slope_prev, s.slope_before)
+                ),
                 s.detectable_change_rel
                     .map_or("–".into(), |d| format!("{:.0} %", 100.0 * d)),
             ),
-            None => ("–".into(), "–".into(), "–".into(), "–".into()),
+            None => Default::default(),
         };
         println!(
-            "| {} | {} | {} | {last} | {prev} | {zz} | {sees} | {} | {} |",
+            "| {} | {} | {} | {last} | {prev} | {before} | {zz} | {sees} | {} | {} |",
             c.label(),
             c.samples_reported,
             c.mean_series.len(),

@@ -121,6 +121,32 @@ fn a_rate_that_doubles_in_the_last_twenty_is_not_steady() {
 }
 
 #[test]
+fn a_peak_after_incubation_is_not_steady() {
+    // The rate doubles at impact 31 and holds: the last two windows (31-50, 51-70) agree with
+    // each other, as two windows of a peak do, and the third (11-30) shows the rise.
+    let r = aggregate_cell(
+        &noisy_cell(|k| if k >= 30 { 4e-3 } else { 2e-3 }),
+        SLOPE_WINDOW,
+    )
+    .unwrap();
+    let s = r.steady_state.unwrap();
+    assert!(!s.steady, "{}", s.reason);
+    assert!(
+        s.reason
+            .contains("that previous slope against the 20 before's"),
+        "{}",
+        s.reason
+    );
+    let (last, prev, before) = (
+        s.slope_last.unwrap(),
+        s.slope_prev.unwrap(),
+        s.slope_before.unwrap(),
+    );
+    assert!((last.value - prev.value).abs() <= 2.0 * last.sem.hypot(prev.sem));
+    assert!(prev.value > 1.5 * before.value, "{prev:?} {before:?}");
+}
+
+#[test]
 fn a_cell_with_no_loss_in_its_last_twenty_is_not_steady() {
     let samples = vec![sample(0, 60, |k| if k < 35 { 2e-3 } else { 0.0 })];
     let s = aggregate_cell(&cell(60, samples), SLOPE_WINDOW)
@@ -137,18 +163,24 @@ fn a_cell_with_no_loss_in_its_last_twenty_is_not_steady() {
 
 #[test]
 fn too_short_or_lossless_or_ragged_cells_say_why() {
-    let short = aggregate_cell(&cell(39, vec![sample(0, 39, |_| 1e-3)]), SLOPE_WINDOW).unwrap();
+    let short = aggregate_cell(&cell(59, vec![sample(0, 59, |_| 1e-3)]), SLOPE_WINDOW).unwrap();
     let s = short.steady_state.unwrap();
-    assert!(!s.steady && s.slope_last.is_none() && s.window_first_impact.is_none());
-    assert!(s.reason.contains("only 39 impacts"), "{}", s.reason);
+    assert!(!s.steady && s.slope_before.is_none() && s.window_first_impact.is_none());
+    assert!(s.slope_last.is_some() && s.slope_prev.is_some());
+    assert!(
+        s.reason
+            .contains("only 59 impacts; 3 20-impact slopes need 60"),
+        "{}",
+        s.reason
+    );
 
     let lossless = aggregate_cell(&cell(30, vec![sample(0, 30, |_| 0.0)]), SLOPE_WINDOW).unwrap();
     let s = lossless.steady_state.unwrap();
     assert!(!s.steady);
     assert_eq!((s.incubation_impacts, s.samples_without_loss), (None, 1));
 
-    // One of two samples has 25 of 40 impacts: the window's mean changes samples midway.
-    let ragged = cell(40, vec![sample(0, 40, |_| 1e-3), sample(1, 25, |_| 1e-3)]);
+    // One of two samples has 45 of 60 impacts: the window's mean changes samples midway.
+    let ragged = cell(60, vec![sample(0, 60, |_| 1e-3), sample(1, 45, |_| 1e-3)]);
     let s = aggregate_cell(&ragged, SLOPE_WINDOW)
         .unwrap()
         .steady_state
@@ -191,13 +223,19 @@ fn eighty_percent_of_samples_must_be_past_incubation() {
         .unwrap();
     assert!(!s.steady);
     assert!(s.reason.starts_with("only 3 of 5 samples"), "{}", s.reason);
-    // The late sample's start shows in the slopes unless it falls before the window.
-    let s = with_late(30);
+    // The late sample's start shows in the slopes unless it falls before the three windows.
+    let s = with_late(10);
     assert_eq!(
         s.samples_incubated_by_window, 5,
-        "first loss at 31 is at the window start"
+        "first loss at 11 is at the first window's start"
     );
     assert!(s.steady, "{}", s.reason);
+    // At the start of the last two windows it counts as incubated, but the window before them
+    // lacks its loss: the third window sees what the incubation share lets through.
+    let s = with_late(30);
+    assert_eq!(s.samples_incubated_by_window, 5);
+    assert!(!s.steady, "{}", s.reason);
+    assert!(s.reason.contains("that previous slope"), "{}", s.reason);
     // Later, its start raises the last slope by a quarter with no scatter to hide it.
     let s = with_late(50);
     assert_eq!(s.samples_incubated_by_window, 4);

@@ -628,6 +628,7 @@ mod tests {
             points: 20,
             slope_last: None,
             slope_prev: None,
+            slope_before: None,
             detectable_change_rel: None,
         });
         c

@@ -118,20 +118,20 @@ async fn a_steady_cell_is_not_extended() {
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path()).await;
     let sp = spec(
-        r#"{"until_steady": {"min": 40, "max": 60, "step": 5}}"#,
+        r#"{"until_steady": {"min": 60, "max": 80, "step": 5}}"#,
         "2",
     );
     let id = s.create_campaign(&sp, None).await.unwrap().id;
-    // The same loss from the first impact on: linear, past incubation, steady at the 40
-    // impacts the steady check's two slopes need.
+    // The same loss from the first impact on: linear, past incubation, steady at the 60
+    // impacts the steady check's three slopes need.
     run_one(&s, |_, _| 0.3).await;
     run_one(&s, |_, _| 0.3).await;
     let st = s.status(id).await.unwrap();
     assert_eq!(st.state, CampaignState::Done);
-    assert_eq!(st.impacts_total, 80);
+    assert_eq!(st.impacts_total, 120);
     assert_eq!(checkpoints(&s).await, 0);
     let r = s.results(id, false).await.unwrap().results;
-    assert_eq!(r.cells[0].impacts_planned, 40);
+    assert_eq!(r.cells[0].impacts_planned, 60);
     assert_eq!(r.steady, Some(true));
 }
 

@@ -7,12 +7,17 @@
 //! conditions, all of which must hold:
 //!
 //! 1. the least-squares slope over the last [`STEADY_POINTS`] impacts (the erosion window)
-//!    agrees with the slope over the [`STEADY_POINTS`] before them within [`STEADY_SIGMAS`]
-//!    combined standard errors;
+//!    agrees with the slope over the [`STEADY_POINTS`] before them, and that one with the slope
+//!    over the [`STEADY_POINTS`] before it, each pair within [`STEADY_SIGMAS`] combined
+//!    standard errors ([`STEADY_WINDOWS`] windows);
 //! 2. at least [`STEADY_INCUBATED_PERCENT`] % of the samples lost their first mass at or
-//!    before the first impact of those 2 × [`STEADY_POINTS`] impacts, so both slopes are past
+//!    before the first impact of the last 2 × [`STEADY_POINTS`] impacts, so the last two slopes are past
 //!    incubation;
 //! 3. the last slope is positive.
+//!
+//! Three windows, not two: after incubation the rate can peak for 40 impacts and then fall by
+//! half (the 16-per-Dg ladder rung, `docs/results.md`), and two windows of such a peak agree
+//! with each other. The window before them, on the rise, does not.
 //!
 //! Each cell also reports the smallest change of rate the test can see,
 //! [`SteadyState::detectable_change_rel`]: [`STEADY_SIGMAS`] combined standard errors over the
@@ -36,12 +41,15 @@ use crate::stats::{slope_fit, SlopeFit};
 /// 20 impacts before it.
 pub const STEADY_POINTS: usize = SLOPE_WINDOW;
 
-/// Largest difference of the two slopes, in combined standard errors
+/// Windows of [`STEADY_POINTS`] impacts whose adjacent slopes must agree.
+pub const STEADY_WINDOWS: usize = 3;
+
+/// Largest difference of two adjacent slopes, in combined standard errors
 /// `√(se_last² + se_prev²)`, that still counts as agreement (about a 95 % two-sided test).
 pub const STEADY_SIGMAS: f64 = 2.0;
 
 /// Smallest share of samples, in percent, that must have lost mass by the first impact of
-/// the two compared slopes: one sample in five may still be incubating (see
+/// the last two compared slopes: one sample in five may still be incubating (see
 /// `docs/erosion.md`).
 pub const STEADY_INCUBATED_PERCENT: usize = 80;
 
@@ -73,7 +81,8 @@ pub struct SteadyState {
     /// so the check can be made again from the file ([`reassess`]); empty in older files.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub first_loss_impacts: Vec<Option<usize>>,
-    /// First impact of the two compared slopes (1-based); `null` when the series is shorter.
+    /// First impact of the last two compared slopes (1-based), where incubation is judged; `null`
+    /// when the series is shorter than the three windows.
     pub window_first_impact: Option<usize>,
     /// Reported samples whose first loss came at or before `window_first_impact`.
     pub samples_incubated_by_window: usize,
@@ -86,6 +95,10 @@ pub struct SteadyState {
     /// Slope of the mean series over the `points` impacts before those.
     #[serde(alias = "slope_prev10")]
     pub slope_prev: Option<SlopeFit>,
+    /// Slope of the mean series over the `points` impacts before `slope_prev`'s; `null` below
+    /// [`STEADY_WINDOWS`] × `points` and in files checked under the two-window rule.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slope_before: Option<SlopeFit>,
     /// Smallest relative change of rate the check would flag: [`STEADY_SIGMAS`] combined
     /// standard errors over |last slope|; `null` where there are no slopes or the last is 0.
     #[serde(default)]
@@ -97,22 +110,36 @@ fn older_points() -> usize {
     10
 }
 
-/// The two slopes of the steady-state check (last [`STEADY_POINTS`] and the
-/// [`STEADY_POINTS`] before) from a mean series (Fig. 10b); both `None` when it is shorter
-/// than both together.
-pub fn mean_series_slopes(mean: &[MeanPoint]) -> (Option<SlopeFit>, Option<SlopeFit>) {
+/// The slopes of the steady-state check from a mean series (Fig. 10b), latest first: over the
+/// last [`STEADY_POINTS`] impacts, the [`STEADY_POINTS`] before, and the [`STEADY_POINTS`]
+/// before those; a window the series is too short for is `None`.
+pub fn mean_series_slopes(mean: &[MeanPoint]) -> [Option<SlopeFit>; STEADY_WINDOWS] {
     let n = mean.len();
-    if n < 2 * STEADY_POINTS {
-        return (None, None);
-    }
-    let fit = |part: &[MeanPoint]| {
+    let fit = |w: usize| {
+        let end = n.checked_sub(w * STEADY_POINTS)?;
+        let part = &mean[end.checked_sub(STEADY_POINTS)?..end];
         let x: Vec<f64> = part.iter().map(|p| p.grain_mass_kg).collect();
         let y: Vec<f64> = part.iter().map(|p| p.mass_loss_kg).collect();
         slope_fit(&x, &y)
     };
-    let last = &mean[n - STEADY_POINTS..];
-    let prev = &mean[n - 2 * STEADY_POINTS..n - STEADY_POINTS];
-    (fit(last), fit(prev))
+    std::array::from_fn(fit)
+}
+
+/// Whether slopes `a` (later) and `b` agree within [`STEADY_SIGMAS`] combined standard
+/// errors, and the difference in words.
+fn compare(a: SlopeFit, b: SlopeFit) -> (bool, String) {
+    let diff = (a.value - b.value).abs();
+    let combined = a.sem.hypot(b.sem);
+    // Rounding alone must not split two slopes of an exactly linear series.
+    let rounding = 1e-9 * a.value.abs().max(b.value.abs());
+    let z = if combined > 0.0 {
+        format!("{:.1} combined standard errors", diff / combined)
+    } else if diff <= rounding {
+        "no difference".to_string()
+    } else {
+        "a difference with no scatter".to_string()
+    };
+    (diff <= STEADY_SIGMAS * combined + rounding, z)
 }
 
 /// Impact number (1-based) of a series' first mass loss; `None` when it lost nothing.
@@ -216,11 +243,13 @@ fn assess_first_losses(first: &[Option<usize>], mean: &[MeanPoint]) -> SteadySta
     };
     let samples_without_loss = first.len() - lost.len();
     let n = mean.len();
+    // Incubation is judged at the start of the last two windows; all three must fit.
     let window = 2 * STEADY_POINTS;
-    let window_first_impact = (n >= window).then(|| n - window + 1);
+    let needed = STEADY_WINDOWS * STEADY_POINTS;
+    let window_first_impact = (n >= needed).then(|| n - window + 1);
     let samples_incubated_by_window =
         window_first_impact.map_or(0, |start| lost.iter().filter(|&&k| k <= start).count());
-    let (slope_last, slope_prev) = mean_series_slopes(mean);
+    let [slope_last, slope_prev, slope_before] = mean_series_slopes(mean);
     let detectable_change_rel = match (slope_last, slope_prev) {
         (Some(l), Some(p)) if l.value != 0.0 => {
             Some(STEADY_SIGMAS * l.sem.hypot(p.sem) / l.value.abs())
@@ -232,24 +261,24 @@ fn assess_first_losses(first: &[Option<usize>], mean: &[MeanPoint]) -> SteadySta
     let mut held = Vec::new();
     if first.is_empty() {
         broken.push("no samples reported".to_string());
-    } else if n < window {
+    } else if n < needed {
         broken.push(format!(
-            "only {n} impacts; two {STEADY_POINTS}-impact slopes need {window}"
+            "only {n} impacts; {STEADY_WINDOWS} {STEADY_POINTS}-impact slopes need {needed}"
         ));
     }
     if let Some(start) = window_first_impact {
-        let counts = mean[start - 1..].iter().map(|p| p.samples);
+        let counts = mean[n - needed..].iter().map(|p| p.samples);
         let (lo, hi) = (counts.clone().min(), counts.max());
         if lo != hi {
             broken.push(format!(
-                "the last {window} points average {} to {} samples: some are still running",
+                "the last {needed} points average {} to {} samples: some are still running",
                 lo.unwrap_or(0),
                 hi.unwrap_or(0)
             ));
         }
         let share = format!(
             "{samples_incubated_by_window} of {} samples lost mass by impact {start}, where \
-             the two compared {STEADY_POINTS}-impact slopes start",
+             the last two compared {STEADY_POINTS}-impact slopes start",
             first.len()
         );
         if samples_incubated_by_window * 100 >= STEADY_INCUBATED_PERCENT * first.len() {
@@ -260,23 +289,12 @@ fn assess_first_losses(first: &[Option<usize>], mean: &[MeanPoint]) -> SteadySta
             ));
         }
     }
-    match (slope_last, slope_prev) {
-        (Some(last), Some(prev)) => {
-            let diff = (last.value - prev.value).abs();
-            let combined = (last.sem * last.sem + prev.sem * prev.sem).sqrt();
-            // Rounding alone must not split two slopes of an exactly linear series.
-            let rounding = 1e-9 * last.value.abs().max(prev.value.abs());
-            let agree = diff <= STEADY_SIGMAS * combined + rounding;
-            let z = if combined > 0.0 {
-                format!("{:.1} combined standard errors", diff / combined)
-            } else if diff <= rounding {
-                "no difference".to_string()
-            } else {
-                "a difference with no scatter".to_string()
-            };
+    match (slope_last, slope_prev, slope_before) {
+        (Some(last), Some(prev), Some(before)) => {
             let sees = detectable_change_rel.map_or(String::new(), |d| {
                 format!(" (the check sees changes of {:.0} % and more)", 100.0 * d)
             });
+            let (agree, z) = compare(last, prev);
             let text = format!(
                 "last-{STEADY_POINTS} slope {} against the previous {STEADY_POINTS}'s {}: {z}{sees}",
                 show(last),
@@ -287,11 +305,21 @@ fn assess_first_losses(first: &[Option<usize>], mean: &[MeanPoint]) -> SteadySta
             } else {
                 broken.push(format!("{text} (at most {STEADY_SIGMAS} allowed)"));
             }
+            let (agree, z) = compare(prev, before);
+            let text = format!(
+                "that previous slope against the {STEADY_POINTS} before's {}: {z}",
+                show(before)
+            );
+            if agree {
+                held.push(text);
+            } else {
+                broken.push(format!("{text} (at most {STEADY_SIGMAS} allowed)"));
+            }
             if last.value <= 0.0 {
                 broken.push(format!("no mass lost in the last {STEADY_POINTS} impacts"));
             }
         }
-        _ if n >= window => broken.push("the slopes could not be fitted".to_string()),
+        _ if n >= needed => broken.push("the slopes could not be fitted".to_string()),
         _ => {}
     }
     let steady = broken.is_empty();
@@ -306,6 +334,7 @@ fn assess_first_losses(first: &[Option<usize>], mean: &[MeanPoint]) -> SteadySta
         points: STEADY_POINTS,
         slope_last,
         slope_prev,
+        slope_before,
         detectable_change_rel,
     }
 }
