@@ -384,3 +384,23 @@ fn compare_prints_the_reference_tables_and_refuses_a_bad_file() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-results.json"));
 }
+
+#[test]
+fn a_fit_document_is_drawn_as_its_model_through_its_cells() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // Four speeds and three angles: both charts.
+    let (dir, stdout) = plot(&root.join("docs/erosion/velocity-quick/fit.json"));
+    let files = stems(dir.path());
+    assert_has(&files, "fit_speed");
+    assert_has(&files, "fit_angle");
+    assert_eq!(check_images(dir.path()), 2, "{stdout}");
+    // One speed: the speed chart is skipped, and says why.
+    let (dir, stdout) = plot(&root.join("docs/erosion/size-quick/fit.json"));
+    let files = stems(dir.path());
+    assert_has(&files, "fit_angle");
+    assert!(!files.contains("fit_speed.png"), "{files:?}");
+    assert!(
+        stdout.contains("fit_speed: the cells have one value of its axis"),
+        "{stdout}"
+    );
+}

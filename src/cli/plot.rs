@@ -15,7 +15,8 @@ use plotters::prelude::*;
 #[derive(ClapArgs)]
 pub struct Args {
     /// Results JSON from `grit run` (OUT/results.json) or `grit results -o FILE`; per-sample
-    /// curves need the raw series (`--raw` on either). Several files are drawn as one; a cell
+    /// curves need the raw series (`--raw` on either). A fit document (`grit fit -o`) is drawn
+    /// as the fitted model through its cells, against speed and against angle. Several files are drawn as one; a cell
     /// (angle, shape) an earlier file already has is left out. Files from `grit jet -o` are
     /// gathered into cells (equal parameters; seeds are samples) and drawn as a jet campaign.
     #[arg(required = true)]
@@ -117,6 +118,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         });
+    // A fit document from `grit fit -o` is drawn as its model through its cells.
+    if let [one] = a.results.as_slice() {
+        if let Some(doc) = fit_document(one) {
+            let report = grit_plot::plot_fit(&doc.fit, &out)?;
+            print_report(&mut std::io::stdout().lock(), &[], &report);
+            return Ok(ExitCode::SUCCESS);
+        }
+    }
     // Single `grit jet` runs are gathered into cells and drawn as a jet campaign.
     if let Some(r) = grit_plot::load_jet_runs(&a.results)? {
         return draw_jet(&r, &out);
@@ -138,6 +147,17 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let _ = write!(o, "{}", grit_plot::summary_table(&input.results));
     print_report(&mut o, &merge_notes, &report);
     Ok(ExitCode::SUCCESS)
+}
+
+/// The fit document in `path`, when it is one (its `kind` says so); anything else is left to
+/// the results readers and their errors.
+fn fit_document(path: &Path) -> Option<grit_erosion::models::export::FitDocument> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    if v.get("kind")?.as_str()? != grit_erosion::models::export::FIT_KIND {
+        return None;
+    }
+    serde_json::from_value(v).ok()
 }
 
 /// Draws a jet campaign's charts and prints its table and the files written.

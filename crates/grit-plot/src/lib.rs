@@ -16,6 +16,7 @@
 mod analysis;
 mod charts;
 mod draw;
+mod fit;
 mod fonts;
 mod input;
 mod jet;
@@ -29,6 +30,7 @@ use std::path::{Path, PathBuf};
 use grit_erosion::CampaignResults;
 
 pub use draw::colour;
+pub use fit::plot_fit;
 pub use fonts::register_fonts;
 pub use input::{
     load, load_any, load_jet_runs, merge, parse, parse_any, AnyInput, PlotInput, RawImpact,
