@@ -160,8 +160,9 @@ pub struct RepeatedCell {
     pub rows: Vec<RepeatRow>,
 }
 
-/// The spec's single value of `key` (a number, or a one-element sweep).
-fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
+/// The spec's single value of `key` (e.g. `["grain", "diameter_m"]`): a number, or a
+/// one-element sweep.
+pub(crate) fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
     let mut v = spec?;
     for k in key {
         v = v.get(k)?;

@@ -13,6 +13,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use crate::impact::aggregate::CampaignResults;
+use crate::models::compare::spec_number;
 use crate::models::oka::{
     oka_g, oka_silica_exponents, shape_modification, FitError, ShapeExponents, ShapeReference,
 };
@@ -334,18 +335,6 @@ fn positive(field: &str, v: f64) -> Result<(), FitError> {
         Ok(())
     } else {
         Err(invalid(field, format!("must be finite and > 0, got {v}")))
-    }
-}
-
-/// The value of `key` (e.g. `["grain", "diameter_m"]`) in a spec: a number or a one-element list.
-fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
-    let mut v = spec?;
-    for k in key {
-        v = v.get(k)?;
-    }
-    match v {
-        serde_json::Value::Array(a) if a.len() == 1 => a[0].as_f64(),
-        v => v.as_f64(),
     }
 }
 

@@ -126,8 +126,8 @@ pub fn mean_series_slopes(mean: &[MeanPoint]) -> [Option<SlopeFit>; STEADY_WINDO
 }
 
 /// Whether slopes `a` (later) and `b` agree within [`STEADY_SIGMAS`] combined standard
-/// errors, and the difference in words.
-fn compare(a: SlopeFit, b: SlopeFit) -> (bool, String) {
+/// errors, and the difference in words; the jet's stage-3 check uses it too.
+pub(crate) fn compare(a: SlopeFit, b: SlopeFit) -> (bool, String) {
     let diff = (a.value - b.value).abs();
     let combined = a.sem.hypot(b.sem);
     // Rounding alone must not split two slopes of an exactly linear series.

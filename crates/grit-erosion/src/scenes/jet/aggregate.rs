@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{JetParams, JetSlice, Layout};
 use crate::campaign::Scene;
-use crate::impact::steady::{Incubation, STEADY_INCUBATED_PERCENT, STEADY_SIGMAS};
+use crate::impact::steady::{compare, Incubation, STEADY_INCUBATED_PERCENT, STEADY_SIGMAS};
 use crate::stats::{slope_fit, SlopeFit};
 use crate::stats::{stats, AggregateError, Stats};
 
@@ -408,23 +408,13 @@ pub fn assess_stage3(mean: &[JetMeanPoint], samples: &[JetSampleInput]) -> Stage
     if w >= STAGE3_MIN_POINTS {
         match (first, last) {
             (Some(a), Some(b)) => {
-                let diff = (b.value - a.value).abs();
-                let combined = (a.sem * a.sem + b.sem * b.sem).sqrt();
-                // Rounding alone must not split the halves of an exactly linear series.
-                let rounding = 1e-9 * a.value.abs().max(b.value.abs());
-                let z = if combined > 0.0 {
-                    format!("{:.1} combined standard errors", diff / combined)
-                } else if diff <= rounding {
-                    "no difference".to_string()
-                } else {
-                    "a difference with no scatter".to_string()
-                };
+                let (agree, z) = compare(b, a);
                 let text = format!(
                     "last-half slope {} against the first half's {}: {z}",
                     show(b),
                     show(a)
                 );
-                if diff <= STEADY_SIGMAS * combined + rounding {
+                if agree {
                     held.push(text);
                 } else {
                     broken.push(format!("{text} (at most {STEADY_SIGMAS} allowed)"));
