@@ -370,7 +370,11 @@ mod tests {
         let cells = s.cells().unwrap();
         assert_eq!(cells[0].impacts, 21);
         assert_eq!(cells[0].until_steady, Some(rule));
-        assert_eq!(s.impacts_total().unwrap(), 21 * 2 * 4 * 25);
+        let total = crate::campaign::AnySpec::Impact(s)
+            .plan()
+            .unwrap()
+            .units_total;
+        assert_eq!(total, 21 * 2 * 4 * 25);
 
         let s = CampaignSpec::from_json(
             r#"{"angles_deg": [15, 45], "impacts": {"15": {"until_steady": {"min": 21, "max": 60, "step": 5}}, "default": 30}}"#,

@@ -498,15 +498,6 @@ impl CampaignSpec {
         }
         Ok(jobs)
     }
-
-    /// Total impacts the campaign first plans (for progress and ETA); extended cells raise it.
-    pub fn impacts_total(&self) -> Result<u64, SpecError> {
-        Ok(self
-            .cells()?
-            .iter()
-            .map(|c| c.impacts as u64 * self.samples.initial() as u64)
-            .sum())
-    }
 }
 
 impl Cell {
@@ -576,7 +567,8 @@ mod tests {
         let jobs = s.expand().unwrap();
         assert_eq!(jobs.len(), 24 * 25);
         let total: u64 = (140 + 70 + 4 * 60) * 4 * 25;
-        assert_eq!(s.impacts_total().unwrap(), total);
+        let plan = crate::campaign::AnySpec::Impact(s).plan().unwrap();
+        assert_eq!(plan.units_total, total);
     }
 
     #[test]

@@ -435,15 +435,6 @@ impl JetCampaignSpec {
         }
         Ok(jobs)
     }
-
-    /// Slices of the whole campaign (its unit of progress); validates first.
-    pub fn slices_total(&self) -> Result<u64, SpecError> {
-        Ok(self
-            .cells()?
-            .iter()
-            .map(|c| c.slices as u64 * self.samples as u64)
-            .sum())
-    }
 }
 
 fn both_speeds() -> SpecError {
@@ -484,7 +475,7 @@ mod tests {
         assert!(cells[0].swept.is_empty());
         assert_eq!(s.expand().unwrap().len(), DEFAULT_JET_SAMPLES as usize);
         assert_eq!(
-            s.slices_total().unwrap(),
+            crate::campaign::AnySpec::Jet(s).plan().unwrap().units_total,
             JetParams::default().slices() as u64 * DEFAULT_JET_SAMPLES as u64
         );
     }
