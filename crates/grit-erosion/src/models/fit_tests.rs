@@ -29,19 +29,6 @@ fn truth() -> FullOkaModel {
     }
 }
 
-/// Deterministic noise in [−1, 1] (a fixed LCG), so the noisy tests never flake.
-fn noise(n: usize, seed: u64) -> Vec<f64> {
-    let mut s: u64 = 0x9e37_79b9_7f4a_7c15 ^ seed;
-    (0..n)
-        .map(|_| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        })
-        .collect()
-}
-
 /// Cells of `model` at every combination, each with a 5 % standard error.
 fn cells(
     model: &FullOkaModel,
@@ -143,7 +130,7 @@ fn noisy_cells_give_parameters_within_their_errors_and_chi2_near_one() {
     let t = truth();
     let mut c = grid(&t);
     // Uniform noise on [−√3 σ, √3 σ] has standard deviation σ.
-    for (cell, e) in c.iter_mut().zip(noise(36, 7)) {
+    for (cell, e) in c.iter_mut().zip(crate::models::test_noise(36, 7)) {
         cell.erosion += 3f64.sqrt() * e * cell.erosion_sem;
     }
     let fit = fit_full_oka(&c, &options(&[])).unwrap();

@@ -652,19 +652,6 @@ mod tests {
             .collect()
     }
 
-    /// Deterministic noise in [−1, 1] (a fixed LCG), so the noisy tests never flake.
-    fn noise(n: usize) -> Vec<f64> {
-        let mut s: u64 = 0x9e37_79b9_7f4a_7c15;
-        (0..n)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-            })
-            .collect()
-    }
-
     #[test]
     fn oka_silica_on_aisi_304_matches_notes() {
         let m = OkaModel::silica(AISI304_HV_GPA, 1.0);
@@ -742,7 +729,7 @@ mod tests {
     fn oka_fit_with_noise_stays_near_truth() {
         let truth = OkaModel::silica(AISI304_HV_GPA, 1.5e-3);
         let angles: Vec<f64> = (1..=18).map(|k| 5.0 * k as f64).collect();
-        let eps = noise(angles.len());
+        let eps = crate::models::test_noise(angles.len(), 0);
         let pts: Vec<ErosionPoint> = angles
             .iter()
             .zip(&eps)
