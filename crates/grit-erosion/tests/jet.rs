@@ -29,30 +29,36 @@ fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .install(f)
 }
 
-#[test]
-fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
+/// Run `p` seeded `seed` whole on two threads, and again on one thread resumed from its
+/// checkpoint after two slices.
+fn whole_and_resumed(p: &JetParams, seed: u64) -> (JetRun, JetRun) {
     let whole = on_threads(2, || {
-        let mut run = JetRun::new(tiny(), 5).unwrap();
+        let mut run = JetRun::new(p.clone(), seed).unwrap();
         while !run.finished() {
             run.run_next_slice().unwrap();
         }
         run
     });
-    assert_eq!(whole.slices().len(), 4);
-    let last = &whole.slices()[3];
-    assert!(last.grains_fed > 0, "no grain was fed");
-    assert!(last.sample.max_plastic_strain > 0.0, "the jet left no mark");
     let resumed = on_threads(1, || {
-        let mut run = JetRun::new(tiny(), 5).unwrap();
+        let mut run = JetRun::new(p.clone(), seed).unwrap();
         run.run_next_slice().unwrap();
         run.run_next_slice().unwrap();
-        let bytes = run.checkpoint();
-        let mut back = JetRun::resume(&tiny(), 5, &bytes).unwrap();
+        let mut back = JetRun::resume(p, seed, &run.checkpoint()).unwrap();
         while !back.finished() {
             back.run_next_slice().unwrap();
         }
         back
     });
+    (whole, resumed)
+}
+
+#[test]
+fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
+    let (whole, resumed) = whole_and_resumed(&tiny(), 5);
+    assert_eq!(whole.slices().len(), 4);
+    let last = &whole.slices()[3];
+    assert!(last.grains_fed > 0, "no grain was fed");
+    assert!(last.sample.max_plastic_strain > 0.0, "the jet left no mark");
     // Everything but the wall-clock seconds of each slice.
     let state = |run: &JetRun| {
         let mut slices = run.slices().to_vec();
@@ -223,13 +229,7 @@ fn a_run_extends_to_its_own_end_or_later_but_not_into_its_slices() {
 
 #[test]
 fn sandstone_loses_mass_and_resumes_bit_for_bit() {
-    let whole = on_threads(2, || {
-        let mut run = JetRun::new(tiny_rock(), 3).unwrap();
-        while !run.finished() {
-            run.run_next_slice().unwrap();
-        }
-        run
-    });
+    let (whole, resumed) = whole_and_resumed(&tiny_rock(), 3);
     let last = &whole.slices()[whole.slices().len() - 1];
     assert!(
         last.sample.mass_loss_kg_m > 0.0,
@@ -238,16 +238,6 @@ fn sandstone_loses_mass_and_resumes_bit_for_bit() {
     );
     let p = whole.world().particles();
     assert!(p.bulking.iter().any(|&b| b > 0.0), "no particle bulked");
-    let resumed = on_threads(1, || {
-        let mut run = JetRun::new(tiny_rock(), 3).unwrap();
-        run.run_next_slice().unwrap();
-        run.run_next_slice().unwrap();
-        let mut back = JetRun::resume(&tiny_rock(), 3, &run.checkpoint()).unwrap();
-        while !back.finished() {
-            back.run_next_slice().unwrap();
-        }
-        back
-    });
     let state = |run: &JetRun| {
         let mut slices = run.slices().to_vec();
         slices.iter_mut().for_each(|s| s.wall_s = 0.0);
