@@ -96,8 +96,8 @@ impl SceneRegistry {
 
     /// The scene stored as `kind`; an internal error for one this coordinator does not run
     /// (a database written by a build with more scenes).
-    pub fn get(&self, kind: &str) -> Result<&dyn FarmScene> {
-        self.0.get(kind).map(|s| &**s).ok_or_else(|| {
+    pub fn get(&self, kind: &str) -> Result<Arc<dyn FarmScene>> {
+        self.0.get(kind).cloned().ok_or_else(|| {
             Error::Internal(format!(
                 "stored scene {kind:?} is not one this coordinator runs"
             ))

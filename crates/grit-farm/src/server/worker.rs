@@ -54,24 +54,17 @@ impl Report {
         }
         let stored = s.store.stored_job(job).await?;
         let scene = s.store.scenes.get(&stored.scene)?;
-        let reported = if units.is_empty() {
-            Reported::none()
-        } else {
-            scene.decode(units)?
-        };
+        let reported = scene.decode(units)?;
         let Some(c) = checkpoint else {
             return Ok((reported, None));
         };
         // Decoding a checkpoint of a large surface or a jet's world takes milliseconds: off
         // the async threads.
-        let scenes = s.store.scenes.clone();
         let checked = tokio::task::spawn_blocking(move || {
-            scenes
-                .get(&stored.scene)
-                .map(|scene| scene.verify_upload(&c, job, &stored.params, stored.seed))
+            scene.verify_upload(&c, job, &stored.params, stored.seed)
         })
         .await
-        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))??;
+        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
         let bytes = checked.map_err(|e| {
             tracing::warn!(job, error = %e, "checkpoint refused; nothing of the request stored");
             Error::invalid(e.field, e.rule)
