@@ -10,9 +10,11 @@ use grit_erosion::models::shapes::Shape;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::charts::legend_box;
 use crate::draw::{
     colour, de, error_bar, prepare_output, save, with_notes, DrawResult, Figure, FONT,
 };
+use crate::jet::axes;
 use crate::{PlotError, Report};
 
 /// kg per kg to mg per g.
@@ -137,9 +139,16 @@ impl Figure for FitChart<'_> {
             Sweep::Angle => "impact angle α (degrees from the surface)",
         };
         let y_desc = "erosion (mg surface lost per g of grains)";
-        macro_rules! draw_on {
-            ($chart:expr) => {{
-                let mut chart = $chart;
+        match self.sweep {
+            Sweep::Speed => {
+                let ymin = values.iter().cloned().fold(f64::INFINITY, f64::min) / 1.3;
+                let mut chart = ChartBuilder::on(&area)
+                    .caption(caption, (FONT, 22))
+                    .margin(15)
+                    .x_label_area_size(55)
+                    .y_label_area_size(85)
+                    .build_cartesian_2d((lo..hi).log_scale(), (ymin..ymax).log_scale())
+                    .map_err(de)?;
                 chart
                     .configure_mesh()
                     .x_desc(x_desc)
@@ -148,62 +157,58 @@ impl Figure for FitChart<'_> {
                     .axis_desc_style((FONT, 17))
                     .draw()
                     .map_err(de)?;
-                for (i, (label, cells)) in groups.iter().enumerate() {
-                    let c = colour(i);
-                    chart
-                        .draw_series(LineSeries::new(curve(cells[0]), c.stroke_width(2)))
-                        .map_err(de)?
-                        .label(format!("{label}: fitted model"))
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(2))
-                        });
-                    for cell in cells {
-                        let (x, e) = (self.x(cell), cell.cell.erosion * MG_PER_G);
-                        let s = cell.cell.erosion_sem * MG_PER_G;
-                        let floor = e / 3.0;
-                        chart
-                            .draw_series(error_bar(
-                                x,
-                                (e - s).max(floor),
-                                e + s,
-                                0.0,
-                                c.stroke_width(1),
-                            ))
-                            .map_err(de)?;
-                        chart
-                            .draw_series(std::iter::once(Circle::new((x, e), 5, c.filled())))
-                            .map_err(de)?;
-                    }
-                }
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK.mix(0.4))
-                    .label_font((FONT, 14))
-                    .draw()
-                    .map_err(de)
-            }};
-        }
-        let builder = |area| {
-            let mut b = ChartBuilder::on(area);
-            b.caption(caption, (FONT, 22))
-                .margin(15)
-                .x_label_area_size(55)
-                .y_label_area_size(85);
-            b
-        };
-        match self.sweep {
-            Sweep::Speed => {
-                let ymin = values.iter().cloned().fold(f64::INFINITY, f64::min) / 1.3;
-                draw_on!(builder(&area)
-                    .build_cartesian_2d((lo..hi).log_scale(), (ymin..ymax).log_scale())
-                    .map_err(de)?)
+                self.draw_groups(&mut chart, &groups, &curve)?;
+                legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
             }
-            Sweep::Angle => draw_on!(builder(&area)
-                .build_cartesian_2d(0.0..95.0, 0.0..ymax)
-                .map_err(de)?),
+            Sweep::Angle => {
+                let mut chart = axes(&area, caption, (0.0..95.0, x_desc), (0.0..ymax, y_desc))?;
+                self.draw_groups(&mut chart, &groups, &curve)?;
+                legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
+            }
         }
+    }
+}
+
+impl FitChart<'_> {
+    /// Each group's fitted curve and its cells with ±1 s.e. bars (the lower bar kept above a
+    /// third of the value, for the log axes), on either axes.
+    fn draw_groups<DB: DrawingBackend, X, Y>(
+        &self,
+        chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+        groups: &[(String, Vec<&CellResidual>)],
+        curve: &dyn Fn(&CellResidual) -> Vec<(f64, f64)>,
+    ) -> DrawResult
+    where
+        X: Ranged<ValueType = f64>,
+        Y: Ranged<ValueType = f64>,
+    {
+        for (i, (label, cells)) in groups.iter().enumerate() {
+            let c = colour(i);
+            chart
+                .draw_series(LineSeries::new(curve(cells[0]), c.stroke_width(2)))
+                .map_err(de)?
+                .label(format!("{label}: fitted model"))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(2))
+                });
+            for cell in cells {
+                let (x, e) = (self.x(cell), cell.cell.erosion * MG_PER_G);
+                let s = cell.cell.erosion_sem * MG_PER_G;
+                chart
+                    .draw_series(error_bar(
+                        x,
+                        (e - s).max(e / 3.0),
+                        e + s,
+                        0.0,
+                        c.stroke_width(1),
+                    ))
+                    .map_err(de)?;
+                chart
+                    .draw_series(std::iter::once(Circle::new((x, e), 5, c.filled())))
+                    .map_err(de)?;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -30,7 +30,7 @@ const MG_PER_KG: f64 = 1e6;
 type Axes<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Axes over `x` × `y` described by `x_desc`, `y_desc`, in the style of the impact charts.
-fn axes<'a, DB: DrawingBackend>(
+pub(crate) fn axes<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     caption: &str,
     (x, x_desc): (Range<f64>, &str),
