@@ -297,6 +297,12 @@ impl Store {
         })
     }
 
+    /// The results JSON the results endpoint serves.
+    pub async fn results_json(&self, id: Uuid, raw: bool) -> Result<String> {
+        serde_json::to_string(&self.results_any(id, raw).await?)
+            .map_err(|e| Error::Internal(e.to_string()))
+    }
+
     /// Aggregated results of a campaign of either scene (partial while jobs remain); with
     /// `raw`, every sample's impacts or slices.
     pub async fn results_any(&self, id: Uuid, raw: bool) -> Result<AnyResults> {

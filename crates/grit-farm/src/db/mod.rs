@@ -55,6 +55,8 @@ mod group_tests;
 #[cfg(test)]
 mod jet_tests;
 #[cfg(test)]
+mod results_tests;
+#[cfg(test)]
 mod tests;
 
 /// Current time in Unix milliseconds.
