@@ -9,7 +9,7 @@ use grit_erosion::ImpactRecord;
 use sqlx::Row;
 use uuid::Uuid;
 
-use super::{imp, impact_params, Store};
+use super::{imp, impact_params, impact_results, Store};
 use crate::api::{CampaignState, ClaimedJob};
 use crate::checkpoint::CheckpointBytes;
 use crate::loadtest::placeholder_record;
@@ -99,7 +99,7 @@ async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
     assert_eq!((st.impacts_total, st.impacts_done), (50, 50));
     assert!(s.claim("w").await.unwrap().is_none());
     assert_eq!(checkpoints(&s).await, 0, "dropped once the cell is final");
-    let r = s.results(id, false).await.unwrap().results;
+    let r = impact_results(&s, id).await;
     let cell = &r.cells[0];
     assert_eq!(cell.impacts_planned, 25);
     assert!(!cell.partial);
@@ -130,7 +130,7 @@ async fn a_steady_cell_is_not_extended() {
     assert_eq!(st.state, CampaignState::Done);
     assert_eq!(st.impacts_total, 120);
     assert_eq!(checkpoints(&s).await, 0);
-    let r = s.results(id, false).await.unwrap().results;
+    let r = impact_results(&s, id).await;
     assert_eq!(r.cells[0].impacts_planned, 60);
     assert_eq!(r.steady, Some(true));
 }
@@ -164,7 +164,7 @@ async fn samples_are_added_until_the_error_bar_or_max() {
     assert_eq!(seen, [2, 3, 4]);
     let st = s.status(id).await.unwrap();
     assert_eq!(st.state, CampaignState::Done);
-    let r = s.results(id, false).await.unwrap().results;
+    let r = impact_results(&s, id).await;
     let cell = &r.cells[0];
     assert_eq!((cell.samples, cell.samples_planned), (5, 5));
     let rel = cell
@@ -185,7 +185,7 @@ async fn samples_stop_once_the_target_is_met() {
     run_one(&s, rate).await;
     let st = s.status(id).await.unwrap();
     assert_eq!(st.state, CampaignState::Done, "1/3 ≤ 0.5: no sample added");
-    let r = s.results(id, false).await.unwrap().results;
+    let r = impact_results(&s, id).await;
     let rel = r.cells[0].erosion_sem_rel.unwrap();
     assert!((rel - 1.0 / 3.0).abs() < 1e-9, "{rel}");
 }
