@@ -26,8 +26,8 @@ mod any;
 pub(crate) mod json;
 mod plan;
 mod stored;
-pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts, JobSpec};
-pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, JetJob, Scene};
+pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts};
+pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, Scene};
 pub use any::{AnySpec, CampaignPlan, PlannedCell};
 pub use plan::{
     annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
