@@ -404,3 +404,48 @@ fn a_fit_document_is_drawn_as_its_model_through_its_cells() {
         "{stdout}"
     );
 }
+
+#[test]
+fn the_resolution_ladder_places_each_file_by_its_spacing_and_judges_steadiness_now() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = grit(&[
+        "plot",
+        "--resolution",
+        root.join("docs/erosion/resolution/ppd16-seed-results.json")
+            .to_str()
+            .unwrap(),
+        root.join("docs/erosion/resolution24-results.json")
+            .to_str()
+            .unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    // The 16 rung's 45° cell passed the rule it ran under and fails the three-window rule.
+    assert!(
+        stdout.contains("| 45° hexagon | 16.0 | 15.62 | 30 × 160 | 1.60 ± 0.20 | no |"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("| 90° hexagon | 24.0 | 10.42 | 10 × 100 | 3.11 ± 0.25 |"),
+        "{stdout}"
+    );
+    assert_has(&stems(dir.path()), "erosion_vs_resolution");
+    let svg = std::fs::read_to_string(dir.path().join("erosion_vs_resolution.svg")).unwrap();
+    assert_eq!(
+        circles(&svg, 5, "#1F77B4", true),
+        2,
+        "both 45° cells hollow"
+    );
+    // A file without a spacing in its spec is refused by name.
+    let quick = data("quick-results.json");
+    let bad = grit(&["plot", "--resolution", quick.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success());
+    assert!(
+        stderr.contains("quick-results.json") && stderr.contains("spacing_m"),
+        "{stderr}"
+    );
+}

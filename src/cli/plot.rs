@@ -24,6 +24,10 @@ pub struct Args {
     /// Folder for the PNG and SVG charts (default: the first results file's folder).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Draw the files as a resolution ladder instead: each cell's erosion against particles
+    /// per grain diameter, one file per spacing (`erosion_vs_resolution`), and print its table.
+    #[arg(long)]
+    pub resolution: bool,
 }
 
 /// Arguments of `grit compare`.
@@ -118,6 +122,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         });
+    if a.resolution {
+        let files = a
+            .results
+            .iter()
+            .map(|p| Ok((p.display().to_string(), grit_plot::load(p)?.results)))
+            .collect::<Result<Vec<_>, grit_plot::PlotError>>()?;
+        let points = grit_plot::ladder(&files)?;
+        let report = grit_plot::plot_ladder(&points, &out)?;
+        let mut o = std::io::stdout().lock();
+        let _ = write!(o, "{}", grit_plot::ladder_table(&points));
+        print_report(&mut o, &[], &report);
+        return Ok(ExitCode::SUCCESS);
+    }
     // A fit document from `grit fit -o` is drawn as its model through its cells.
     if let [one] = a.results.as_slice() {
         if let Some(doc) = fit_document(one) {

@@ -21,6 +21,7 @@ mod fonts;
 mod input;
 mod jet;
 mod jet_picture;
+mod resolution;
 mod stability;
 mod surface;
 mod sweep;
@@ -38,6 +39,7 @@ pub use input::{
 };
 pub use jet::{jet_summary_table, plot_jet};
 pub use jet_picture::{jet_png, JetField, JetPicture};
+pub use resolution::{ladder, ladder_table, plot_ladder, LadderPoint};
 pub use stability::stability_chart;
 pub use surface::{surface_png, viridis, SurfaceField, SurfacePicture};
 pub use sweep::sweep_chart;

@@ -162,7 +162,7 @@ pub struct RepeatedCell {
 
 /// The spec's single value of `key` (e.g. `["grain", "diameter_m"]`): a number, or a
 /// one-element sweep.
-pub(crate) fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
+pub fn spec_number(spec: Option<&serde_json::Value>, key: &[&str]) -> Option<f64> {
     let mut v = spec?;
     for k in key {
         v = v.get(k)?;
