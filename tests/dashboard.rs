@@ -30,11 +30,21 @@ fn start_coordinator(dir: &Path, max_attempts: u32) -> Coordinator {
     )
 }
 
+/// This binary's engine fingerprints, as a worker claims with them: the coordinator pins its
+/// campaigns to them.
+fn engine() -> serde_json::Value {
+    json!(grit_erosion::scene::engines::<grit_erosion::Scenes>().unwrap())
+}
+
 /// Claims the queued job as `worker` and reports a failure, as a worker whose engine stopped
 /// with an error does.
 async fn claim_and_fail(api: &Api, worker: &str, error: &str) -> i64 {
     let (status, job) = api
-        .post("/worker/claim", WORKER, &json!({ "worker": worker }))
+        .post(
+            "/worker/claim",
+            WORKER,
+            &json!({ "worker": worker, "engine": engine() }),
+        )
         .await;
     assert_eq!(status, 200, "{job}");
     let job_id = job["job_id"].as_i64().unwrap();
@@ -141,7 +151,11 @@ async fn page_is_open_and_the_new_endpoints_list_workers_and_failed_jobs() {
 
     // A worker holding a job is listed with it and its heartbeat.
     let (status, job) = api
-        .post("/worker/claim", WORKER, &json!({ "worker": "probe-a" }))
+        .post(
+            "/worker/claim",
+            WORKER,
+            &json!({ "worker": "probe-a", "engine": engine() }),
+        )
         .await;
     assert_eq!(status, 200);
     let w = api.ok("/workers").await;
@@ -173,7 +187,11 @@ async fn page_is_open_and_the_new_endpoints_list_workers_and_failed_jobs() {
     // Distinct milliseconds, so the order by last sight is certain.
     tokio::time::sleep(Duration::from_millis(20)).await;
     let (status, _) = api
-        .post("/worker/claim", WORKER, &json!({ "worker": "probe-idle" }))
+        .post(
+            "/worker/claim",
+            WORKER,
+            &json!({ "worker": "probe-idle", "engine": engine() }),
+        )
         .await;
     assert_eq!(status, 204);
     let w = api.ok("/workers").await;

@@ -7,7 +7,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use grit_farm::api::{CampaignState, CampaignStatus};
-use grit_farm::{Client, Secret};
+use grit_farm::{Client, ClientError, Secret};
 use serde_json::Value;
 use uuid::Uuid;
 
@@ -421,10 +421,11 @@ async fn auth_validation_size_and_unknown_ids() {
             .json(&body)
             .send()
     };
+    let any = "0000000000000000";
     for body in [
-        serde_json::json!({"worker": 5}),
-        serde_json::json!({"worker": ""}),
-        serde_json::json!({"worker": "   "}),
+        serde_json::json!({"worker": 5, "engine": any}),
+        serde_json::json!({"worker": "", "engine": any}),
+        serde_json::json!({"worker": "   ", "engine": any}),
     ] {
         let r = claim(body.clone()).await.unwrap();
         assert_eq!(status_of(&r), 422, "{body}");
@@ -433,6 +434,23 @@ async fn auth_validation_size_and_unknown_ids() {
             "worker",
             "{body}"
         );
+    }
+    // The engine is required and must be fingerprints, each named where it fails.
+    for (body, field) in [
+        (serde_json::json!({"worker": "w"}), "engine"),
+        (
+            serde_json::json!({"worker": "w", "engine": "0a40"}),
+            "engine",
+        ),
+        (
+            serde_json::json!({"worker": "w", "engine": {"impact": "0A408D93D042D5E9"}}),
+            "engine.impact",
+        ),
+        (serde_json::json!({"worker": "w", "engine": {}}), "engine"),
+    ] {
+        let r = claim(body.clone()).await.unwrap();
+        assert_eq!(status_of(&r), 422, "{body}");
+        assert_eq!(r.json::<Value>().await.unwrap()["field"], field, "{body}");
     }
     let r = http
         .post(format!("{api}/worker/claim"))
@@ -448,7 +466,7 @@ async fn auth_validation_size_and_unknown_ids() {
         .post(format!("{api}/worker/claim"))
         .bearer_auth(WORKER)
         .header("content-type", "application/json; charset=utf-8")
-        .body(r#"{"worker": "w"} trailing"#)
+        .body(r#"{"worker": "w", "engine": "0000000000000000"} trailing"#)
         .send()
         .await
         .unwrap();
@@ -480,6 +498,110 @@ async fn auth_validation_size_and_unknown_ids() {
     // The token never reaches the log.
     let log = coord.proc.log_text();
     assert!(!log.contains(SUBMIT) && !log.contains(WORKER));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_campaign_is_leased_only_to_workers_of_its_pinned_engine() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let c = submitter(&coord.url);
+    let id = c.submit(&campaign(1, 2), None).await.unwrap().id;
+    let own = grit_erosion::scene::engines::<grit_erosion::Scenes>().unwrap();
+    // Pinned to the coordinator's own engine, and no worker of it seen yet.
+    let s = c.status(id).await.unwrap();
+    assert_eq!(s.engine.as_deref(), Some(own["impact"].as_str()));
+    assert_eq!(s.engine_seen, Some(false));
+    let out = grit_cli(&coord.url, &["status", &id.to_string()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("warning: no worker with engine {}", own["impact"])),
+        "{stderr}"
+    );
+    // Another engine gets 204 while the job is queued, and is told why.
+    let http = reqwest::Client::new();
+    let r = http
+        .post(format!("{}/api/v1/worker/claim", coord.url))
+        .bearer_auth(WORKER)
+        .json(&serde_json::json!({"worker": "x", "engine": "0000000000000000"}))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status().as_u16(), 204);
+    let why = r.headers()["grit-no-job"].to_str().unwrap().to_string();
+    assert!(
+        why.contains(&format!("pinned to impact engine {}", own["impact"])),
+        "{why}"
+    );
+    assert_eq!(c.status(id).await.unwrap().jobs.queued, 1);
+    // This binary's engine gets it; its units carry that fingerprint, and so do the results.
+    let w = worker_client(&coord.url);
+    let job = w.claim("real").await.unwrap().expect("the pinned job");
+    assert_eq!(c.status(id).await.unwrap().engine_seen, Some(true));
+    let params: grit_erosion::ImpactParams = serde_json::from_value(job.params.clone()).unwrap();
+    let seed = job.seed;
+    let records = tokio::task::spawn_blocking(move || {
+        let mut s = grit_erosion::Sample::new(params, seed).unwrap();
+        (0..2)
+            .map(|_| s.run_next().unwrap().clone())
+            .collect::<Vec<_>>()
+    })
+    .await
+    .unwrap();
+    w.complete(
+        job.job_id,
+        &grit_farm::api::CompleteRequest {
+            lease_id: job.lease_id,
+            units: grit_farm::api::units(&records),
+            checkpoint: None,
+        },
+    )
+    .await
+    .unwrap();
+    let results = c.results_value(id, false).await.unwrap();
+    assert_eq!(results["engine"], own["impact"].as_str(), "{results}");
+    assert!(results["commit"].is_string(), "{results}");
+    assert_eq!(
+        unit_engines(&dir.path().join("farm.db")).await,
+        vec![own["impact"].clone()]
+    );
+    // A spec may name the engine; one that is no fingerprint is refused by field.
+    let named = c
+        .submit(
+            &campaign(1, 2).replacen('{', r#"{"engine": "0123456789abcdef", "#, 1),
+            None,
+        )
+        .await
+        .unwrap()
+        .id;
+    assert_eq!(
+        c.status(named).await.unwrap().engine.as_deref(),
+        Some("0123456789abcdef")
+    );
+    let e = c
+        .submit(
+            &campaign(1, 2).replacen('{', r#"{"engine": "latest", "#, 1),
+            None,
+        )
+        .await
+        .unwrap_err();
+    assert!(
+        matches!(&e, ClientError::Status { field: Some(f), .. } if f == "engine"),
+        "{e}"
+    );
+}
+
+/// The distinct engine fingerprints stamped on the stored units of the database at `path`,
+/// read beside the running coordinator.
+async fn unit_engines(path: &Path) -> Vec<String> {
+    let opts = sqlx::sqlite::SqliteConnectOptions::new()
+        .filename(path)
+        .read_only(true);
+    let pool = sqlx::SqlitePool::connect_with(opts).await.unwrap();
+    sqlx::query_scalar("SELECT DISTINCT engine FROM units ORDER BY 1")
+        .fetch_all(&pool)
+        .await
+        .unwrap()
 }
 
 #[tokio::test(flavor = "multi_thread")]

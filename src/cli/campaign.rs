@@ -43,6 +43,11 @@ pub struct RunArgs {
     /// Include every sample's per-impact series in results.json (as `results --raw`).
     #[arg(long)]
     pub raw: bool,
+    /// When --out holds this campaign pinned to another engine (another grit build that
+    /// computes other bits), run the spec afresh in this new folder instead of refusing.
+    /// Nothing is carried over: a campaign never mixes two engines' samples.
+    #[arg(long, value_name = "NEW_DIR")]
+    pub engine_upgrade: Option<PathBuf>,
 }
 
 /// Where the coordinator is and how to authenticate: the client commands and `grit work`.
@@ -167,14 +172,29 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let spec = AnySpec::from_json(&text)
         .and_then(|s| s.validate().map(|_| s))
         .with_context(|| a.campaign.display().to_string())?;
+    let out = match (
+        embedded::engine_mismatch(&spec, &a.out).await?,
+        &a.engine_upgrade,
+    ) {
+        (Some((pinned, own)), Some(fresh)) => {
+            eprintln!(
+                "--engine-upgrade: {} holds this campaign on engine {pinned}; running it afresh in {} on engine {own}",
+                a.out.display(),
+                fresh.display()
+            );
+            fresh.clone()
+        }
+        _ => a.out.clone(),
+    };
     let opts = EmbeddedOptions {
-        out: a.out.clone(),
+        out: out.clone(),
         workers: a
             .workers
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         threads_per_worker: a.threads,
         checkpoint_every: a.checkpoint_every,
         raw: a.raw,
+        commit: Some(env!("GRIT_COMMIT").to_string()),
     };
     let stop = Stop::default();
     on_signals(stop.clone());
@@ -207,7 +227,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     })
     .await?;
     bar.finish();
-    let results_path = a.out.join("results.json");
+    let results_path = out.join("results.json");
     write_json(&results_path, &outcome.results)?;
     eprintln!(
         "campaign {:?}; results in {}",
@@ -218,11 +238,11 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     warn_unsteady_any(&outcome.results, true);
     // Charts beside results.json (`grit plot` draws the same); a chart that fails leaves
     // the results, already written, standing.
-    match grit_plot::plot_file(&results_path, &a.out) {
+    match grit_plot::plot_file(&results_path, &out) {
         Ok(r) => eprintln!(
             "{} chart files (PNG, SVG) in {}",
             r.files.len(),
-            a.out.display()
+            out.display()
         ),
         Err(e) => eprintln!("charts not written: {e}"),
     }
@@ -430,12 +450,33 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             s.rate_impacts_per_s.map_or("–".into(), |r| format!("{r:.3}/s")),
             fmt_eta(s.eta_s)
         );
+        say!(
+            "engine {}",
+            s.engine
+                .as_deref()
+                .unwrap_or("(not pinned: created before engine pins)")
+        );
         say_last_error(&s);
+    }
+    if let Some(warning) = engine_warning(&s) {
+        eprintln!("{warning}");
     }
     if s.impacts_done > 0 {
         warn_unsteady_remote(&client, id, s.state.is_final()).await;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The warning for a campaign whose jobs wait for an engine no live worker has.
+fn engine_warning(s: &CampaignStatus) -> Option<String> {
+    let waiting = s.jobs.queued + s.jobs.leased > 0;
+    match (&s.engine, s.engine_seen) {
+        (Some(e), Some(false)) if waiting => Some(format!(
+            "warning: no worker with engine {e} was seen in the last lease period; this \
+             campaign's jobs are leased only to workers of that engine (`grit version --json`)"
+        )),
+        _ => None,
+    }
 }
 
 /// `grit status ID --watch`: a bar for the campaign and one per cell, refreshed every 2 s.

@@ -115,7 +115,7 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
     if missing {
         tracing::warn!("a token is not set: its endpoints accept anyone who can connect");
     }
-    let store = Store::open_with(
+    let mut store = Store::open_with(
         &a.db,
         Duration::from_secs_f64(a.lease_ttl_s),
         a.max_attempts,
@@ -123,6 +123,14 @@ pub async fn serve(a: ServeArgs) -> anyhow::Result<ExitCode> {
     )
     .await
     .with_context(|| format!("--db {}", a.db.display()))?;
+    // New campaigns are pinned to the engine this coordinator computes, unless their spec
+    // names one.
+    store.own = grit_farm::OwnEngine {
+        engines: grit_erosion::scene::engines::<grit_erosion::Scenes>()
+            .context("engine fingerprint")?,
+        commit: Some(env!("GRIT_COMMIT").to_string()),
+    };
+    tracing::info!(engines = ?store.own.engines, "new campaigns are pinned to these engines");
     let config = Config {
         submit_token,
         worker_token,

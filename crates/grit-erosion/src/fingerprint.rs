@@ -66,6 +66,17 @@ fn hash_particles(h: &mut Sha256, p: &Particles) {
     }
 }
 
+/// `f`'s fingerprint, computed once per process: a fingerprint is a pure function of the
+/// binary, and a worker process asks for it at every start of a job loop.
+pub fn once(
+    cell: &'static std::sync::OnceLock<Result<String, String>>,
+    f: fn() -> Result<String, SceneError>,
+) -> Result<String, SceneError> {
+    cell.get_or_init(|| f().map_err(|e| e.to_string()))
+        .clone()
+        .map_err(SceneError::Run)
+}
+
 fn hex(h: Sha256) -> String {
     format!("{:x}", h.finalize())[..FINGERPRINT_HEX].to_string()
 }

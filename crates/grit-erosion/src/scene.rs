@@ -29,6 +29,10 @@ pub trait Scene: Sized + Send + Sync + 'static {
     /// What one unit reports.
     type Record: Clone + Serialize + DeserializeOwned + Send + Sync + 'static;
 
+    /// The engine fingerprint of this scene (`crate::fingerprint`): 16 hex digits of a hash
+    /// of a canonical run's final bits, equal for engines that compute the same bits. A farm
+    /// leases a campaign's jobs only to workers whose fingerprint matches the campaign's.
+    fn engine() -> Result<String, SceneError>;
     /// A fresh simulation of `params` seeded `seed`.
     fn start(params: &Self::Params, seed: u64) -> Result<Self, SceneError>;
     /// Goes on from [`Scene::checkpoint`] bytes, which must be this job's own (its
@@ -79,6 +83,24 @@ pub trait SceneVisitor {
     type Output;
     /// Does it with scene `S`.
     fn visit<S: Scene>(self) -> Self::Output;
+}
+
+/// The engine fingerprint of every scene of `Z`, by kind ([`Scene::engine`]).
+pub fn engines<Z: SceneSet>() -> Result<std::collections::BTreeMap<String, String>, SceneError> {
+    struct Engine;
+    impl SceneVisitor for Engine {
+        type Output = Result<String, SceneError>;
+        fn visit<S: Scene>(self) -> Self::Output {
+            S::engine()
+        }
+    }
+    Z::kinds()
+        .iter()
+        .map(|&k| {
+            let fp = Z::visit(k, Engine).expect("a kind the set lists is one it visits")?;
+            Ok((k.to_string(), fp))
+        })
+        .collect()
 }
 
 /// Which scenes a farm runs, by kind: grit's own ([`Scenes`]), or those and more.

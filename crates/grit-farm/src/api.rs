@@ -162,6 +162,15 @@ pub struct CampaignStatus {
     #[serde(default, skip_serializing_if = "is_impact")]
     #[schema(value_type = Option<String>)]
     pub scene: Scene,
+    /// The engine fingerprint the campaign is pinned to; `null` for a campaign created before
+    /// pins, which any engine may run.
+    #[serde(default)]
+    pub engine: Option<String>,
+    /// Whether a worker with the pinned engine claimed or reported within the last lease
+    /// period; `null` for an unpinned campaign. `false` with jobs queued means they wait for
+    /// an engine no running worker has.
+    #[serde(default)]
+    pub engine_seen: Option<bool>,
 }
 
 /// Job state (the `state` column of the jobs table).
@@ -330,6 +339,58 @@ pub struct JobsChanged {
 pub struct ClaimRequest {
     /// A name for the worker (host and process), shown in logs.
     pub worker: String,
+    /// The worker's engine fingerprints (`grit version --json`): an object from scene kind to
+    /// fingerprint, or one fingerprint for every scene. Only jobs of campaigns pinned to the
+    /// worker's fingerprint for their scene are leased to it (`docs/operations.md`, "Mixed
+    /// machines").
+    #[schema(value_type = Object)]
+    pub engine: WorkerEngine,
+}
+
+/// A worker's engine fingerprints in a claim: one per scene it runs, or one for all.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum WorkerEngine {
+    /// The same fingerprint for every scene.
+    One(String),
+    /// The fingerprint of each scene, by kind.
+    PerScene(std::collections::BTreeMap<String, String>),
+}
+
+impl WorkerEngine {
+    /// The fingerprints as the store matches them: a JSON object by scene kind, with `*` for
+    /// one fingerprint of every scene; the error names the bad field.
+    pub fn to_json(&self) -> Result<String, (String, String)> {
+        let bad = |field: String, fp: &str| {
+            (
+                field,
+                format!("`{fp}` is no engine fingerprint: 16 lowercase hex digits, as `grit version --json` prints"),
+            )
+        };
+        let map = match self {
+            WorkerEngine::One(fp) => {
+                if !grit_erosion::campaign::is_fingerprint(fp) {
+                    return Err(bad("engine".into(), fp));
+                }
+                std::collections::BTreeMap::from([("*".to_string(), fp.clone())])
+            }
+            WorkerEngine::PerScene(m) => {
+                if m.is_empty() {
+                    return Err((
+                        "engine".into(),
+                        "must name at least one scene's fingerprint".into(),
+                    ));
+                }
+                for (kind, fp) in m {
+                    if !grit_erosion::campaign::is_fingerprint(fp) {
+                        return Err(bad(format!("engine.{kind}"), fp));
+                    }
+                }
+                m.clone()
+            }
+        };
+        Ok(serde_json::to_string(&map).expect("a map of strings serialises"))
+    }
 }
 
 /// A checkpoint of a sample's surface after `impacts_done` impacts, with the job it belongs

@@ -1,5 +1,6 @@
 //! HTTP client of the coordinator API, used by the CLI, the worker and the benchmark.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use reqwest::StatusCode;
@@ -61,6 +62,8 @@ pub struct Client {
     base: String,
     token: Secret,
     timeout: Duration,
+    /// Whether the coordinator's reason for an empty claim was logged already.
+    told: Arc<std::sync::atomic::AtomicBool>,
 }
 
 impl Client {
@@ -92,6 +95,7 @@ impl Client {
             base: base.trim_end_matches('/').to_string(),
             token,
             timeout: request_timeout,
+            told: Arc::default(),
         })
     }
 
@@ -224,18 +228,39 @@ impl Client {
         .await
     }
 
-    /// Leases a job, or `None` when there is none.
+    /// [`Client::claim_with`] the fingerprints of grit's own scenes as this binary computes
+    /// them.
     pub async fn claim(&self, worker: &str) -> Result<Option<ClaimedJob>, ClientError> {
+        let engines = grit_erosion::scene::engines::<grit_erosion::Scenes>()
+            .map_err(|e| ClientError::Decode(format!("engine fingerprint: {e}")))?;
+        self.claim_with(worker, &WorkerEngine::PerScene(engines))
+            .await
+    }
+
+    /// Leases a job of a campaign pinned to `engine`, or `None` when there is none. Why
+    /// queued jobs were not leased, when the coordinator says, is logged once per client.
+    pub async fn claim_with(
+        &self,
+        worker: &str,
+        engine: &WorkerEngine,
+    ) -> Result<Option<ClaimedJob>, ClientError> {
         let resp = self
             .send(
                 self.http
                     .post(self.url("/worker/claim"))
                     .json(&ClaimRequest {
                         worker: worker.to_string(),
+                        engine: engine.clone(),
                     }),
             )
             .await?;
         if resp.status() == StatusCode::NO_CONTENT {
+            let why = resp.headers().get(crate::server::NO_JOB_HEADER);
+            if let Some(why) = why.and_then(|v| v.to_str().ok()) {
+                if !self.told.swap(true, std::sync::atomic::Ordering::Relaxed) {
+                    tracing::warn!("no job for this worker: {why}");
+                }
+            }
             return Ok(None);
         }
         Self::json(resp).await.map(Some)

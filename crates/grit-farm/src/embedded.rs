@@ -11,7 +11,7 @@ use grit_erosion::campaign::{AnySpec, CampaignSpec};
 
 use crate::api::{AnyResults, CampaignState, CampaignStatus};
 use crate::client::{Client, ClientError};
-use crate::db::Store;
+use crate::db::{OwnEngine, Store};
 use crate::server::{self, Config, Secret};
 use crate::worker::{self, Stop, WorkerOptions};
 
@@ -28,6 +28,8 @@ pub struct EmbeddedOptions {
     pub checkpoint_every: u32,
     /// Include every sample's per-impact series in the results (as `?raw=true`).
     pub raw: bool,
+    /// The commit this grit was built from, recorded with a new campaign.
+    pub commit: Option<String>,
 }
 
 /// What the embedded run reports while it runs.
@@ -81,6 +83,19 @@ pub enum EmbeddedError {
         /// The campaign already in its database.
         id: uuid::Uuid,
     },
+    /// The output folder's campaign is pinned to another engine than this grit's.
+    #[error("--out {out} holds this campaign pinned to engine {pinned}, and this grit computes {own}: its samples would mix two engines' bits. Resume it with a grit of engine {pinned}, or pass --engine-upgrade NEW_DIR to run the spec afresh there with this engine")]
+    OtherEngine {
+        /// The folder.
+        out: PathBuf,
+        /// The fingerprint the campaign is pinned to.
+        pinned: String,
+        /// This grit's fingerprint for the campaign's scene.
+        own: String,
+    },
+    /// This grit's engine fingerprint could not be computed.
+    #[error("engine fingerprint: {0}")]
+    Fingerprint(String),
     /// A database operation failed.
     #[error(transparent)]
     Store(#[from] crate::Error),
@@ -114,6 +129,55 @@ pub fn any_campaign_key(spec: &AnySpec) -> Result<String, serde_json::Error> {
     Ok(format!("grit-run:{:016x}", fnv1a(spec_json.as_bytes())))
 }
 
+/// This grit's engine, as a coordinator records it with the campaigns it creates.
+fn own_engine(commit: Option<String>) -> Result<OwnEngine, EmbeddedError> {
+    Ok(OwnEngine {
+        engines: grit_erosion::scene::engines::<grit_erosion::Scenes>()
+            .map_err(|e| EmbeddedError::Fingerprint(e.to_string()))?,
+        commit,
+    })
+}
+
+/// Campaign `id` (of `spec`) pinned to another engine than `store`'s own: (pinned, own).
+async fn mismatch(
+    store: &Store,
+    id: uuid::Uuid,
+    spec: &AnySpec,
+) -> Result<Option<(String, String)>, EmbeddedError> {
+    let pinned = store.status(id).await?.engine;
+    let own = store.own.engines.get(spec.scene().as_str()).cloned();
+    Ok(match (pinned, own) {
+        (Some(pinned), Some(own)) if pinned != own => Some((pinned, own)),
+        _ => None,
+    })
+}
+
+/// Whether `out` holds `spec`'s campaign pinned to another engine than this grit's, which
+/// [`run`] refuses to resume there: (pinned, own). `None` for a folder without it.
+pub async fn engine_mismatch(
+    spec: &AnySpec,
+    out: &std::path::Path,
+) -> Result<Option<(String, String)>, EmbeddedError> {
+    let db_path = out.join("grit.db");
+    if !db_path.exists() {
+        return Ok(None);
+    }
+    let mut store = Store::open(&db_path, Duration::from_secs(120), 3)
+        .await
+        .map_err(|source| EmbeddedError::Database {
+            path: db_path.clone(),
+            source,
+        })?;
+    store.own = own_engine(None)?;
+    let Some(c) = store.list_campaigns().await?.into_iter().next() else {
+        return Ok(None);
+    };
+    if !store.has_key(&any_campaign_key(spec)?).await? {
+        return Ok(None);
+    }
+    mismatch(&store, c.id, spec).await
+}
+
 /// Runs `spec` to the end (or until `stop`) and returns its results; `on_event` hears of the
 /// start, every status poll and anything worth a line.
 pub async fn run(
@@ -127,12 +191,13 @@ pub async fn run(
         source,
     })?;
     let db_path = opts.out.join("grit.db");
-    let store = Store::open(&db_path, Duration::from_secs(120), 3)
+    let mut store = Store::open(&db_path, Duration::from_secs(120), 3)
         .await
         .map_err(|source| EmbeddedError::Database {
             path: db_path.clone(),
             source,
         })?;
+    store.own = own_engine(opts.commit.clone())?;
     // Nothing else uses this file, so leases left by an interrupted run are dead.
     store.requeue_all_leases().await?;
     let key = any_campaign_key(spec)?;
@@ -147,6 +212,13 @@ pub async fn run(
         }
     }
     let created = store.create(spec, Some(&key)).await?;
+    if let Some((pinned, own)) = mismatch(&store, created.id, spec).await? {
+        return Err(EmbeddedError::OtherEngine {
+            out: opts.out.clone(),
+            pinned,
+            own,
+        });
+    }
     if !created.created {
         // Running again continues the campaign. Jobs that failed here mostly lost their lease
         // while the whole process was stopped or the machine slept (its own workers could not

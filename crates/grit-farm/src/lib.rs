@@ -19,6 +19,6 @@ pub mod server;
 pub mod worker;
 
 pub use client::{Client, ClientError};
-pub use db::{Store, Synchronous};
+pub use db::{OwnEngine, Store, Synchronous};
 pub use error::{Error, Result};
 pub use server::{app, AppState, Config, Secret};

@@ -17,6 +17,7 @@ use serde_json::Value;
 
 use crate::api::{
     units, Checkpoint, ClaimedJob, CompleteRequest, FailRequest, HeartbeatRequest, ReleaseRequest,
+    WorkerEngine,
 };
 use crate::checkpoint::verify;
 use crate::client::{Client, ClientError};
@@ -148,6 +149,8 @@ enum JobEnd {
 
 struct Runner {
     client: Client,
+    /// The fingerprints of the scenes this worker runs, sent with every claim.
+    engine: WorkerEngine,
     opts: WorkerOptions,
     stop: Stop,
     pool: Option<Arc<rayon::ThreadPool>>,
@@ -180,8 +183,12 @@ pub async fn run_scenes<Z: SceneSet>(
         )),
         None => None,
     };
+    let engines = grit_erosion::scene::engines::<Z>()
+        .map_err(|e| WorkerError(format!("engine fingerprint: {e}")))?;
+    tracing::info!(?engines, "engine fingerprints");
     let mut r = Runner {
         client,
+        engine: WorkerEngine::PerScene(engines),
         opts,
         stop,
         pool,
@@ -192,7 +199,7 @@ pub async fn run_scenes<Z: SceneSet>(
         if r.stop.is_set() {
             break;
         }
-        match r.client.claim(&r.opts.name).await {
+        match r.client.claim_with(&r.opts.name, &r.engine).await {
             Ok(Some(job)) => {
                 backoff = Duration::from_millis(500);
                 tracing::info!(

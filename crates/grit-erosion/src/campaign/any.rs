@@ -59,6 +59,14 @@ impl AnySpec {
         }
     }
 
+    /// The engine fingerprint the spec pins, if it names one.
+    pub fn engine(&self) -> Option<&str> {
+        match self {
+            AnySpec::Impact(s) => s.engine.as_deref(),
+            AnySpec::Jet(s) => s.engine.as_deref(),
+        }
+    }
+
     /// Checks every rule of the spec's scene.
     pub fn validate(&self) -> Result<(), SpecError> {
         match self {

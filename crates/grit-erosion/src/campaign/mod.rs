@@ -195,6 +195,28 @@ impl Serialize for MaterialSpec {
     }
 }
 
+/// Checks a pinned engine fingerprint (`engine` of a spec; `crate::fingerprint`): 16
+/// lowercase hex digits, as `grit version --json` prints them.
+pub fn check_engine(engine: Option<&str>) -> Result<(), SpecError> {
+    match engine {
+        Some(e) if !is_fingerprint(e) => Err(err(
+            "engine",
+            format!(
+                "`{e}` is no engine fingerprint: 16 lowercase hex digits, as `grit version \
+                 --json` prints"
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Whether `s` has the form of an engine fingerprint: 16 lowercase hex digits.
+pub fn is_fingerprint(s: &str) -> bool {
+    s.len() == 16
+        && s.bytes()
+            .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+}
+
 /// SplitMix64 finaliser: a bijection on u64 that scrambles every input bit into every output bit.
 pub(crate) fn mix(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

@@ -644,6 +644,8 @@ mod tests {
             spec: None,
             grit_version: None,
             numerics: None,
+            engine: None,
+            commit: None,
         }
     }
 

@@ -19,6 +19,24 @@ use crate::error::{Error, Result};
 /// Window over which the impact rate (and so the ETA) is measured.
 const RATE_WINDOW_MS: i64 = 120_000;
 
+/// A scene's results JSON object with the campaign's pinned `engine` and its creator's
+/// `commit` in front. The keys are spliced in rather than the body parsed and written again,
+/// which would cost a pass over a raw listing of every record and could reorder its keys. An
+/// unpinned campaign's results are left as they were.
+fn with_engine(body: String, engine: Option<String>, commit: Option<String>) -> String {
+    let (Some(engine), Some(rest)) = (engine, body.strip_prefix('{')) else {
+        return body;
+    };
+    let head = serde_json::json!({ "engine": engine, "commit": commit.unwrap_or_else(|| "unknown".into()) })
+        .to_string();
+    let sep = if rest.trim_start().starts_with('}') {
+        ""
+    } else {
+        ","
+    };
+    format!("{}{sep}{rest}", &head[..head.len() - 1])
+}
+
 /// The scene stored in a campaign row's `scene` column.
 fn scene_of(r: &sqlx::sqlite::SqliteRow) -> Scene {
     Scene::parse(&r.get::<String, _>("scene")).unwrap_or_default()
@@ -35,20 +53,29 @@ impl Store {
     ) -> Result<CampaignCreated> {
         let plan = spec.plan()?;
         let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
-        self.create_planned(&plan, &spec_json, spec.name(), idempotency_key)
-            .await
+        self.create_planned(
+            &plan,
+            &spec_json,
+            spec.name(),
+            idempotency_key,
+            spec.engine(),
+        )
+        .await
     }
 
     /// Stores campaign `plan` (its spec as `spec_json`, its name `name`) with all its jobs in
     /// one transaction: [`Store::create`] once the spec is planned, and the way in for a scene
-    /// whose spec grit does not parse.
+    /// whose spec grit does not parse. It is pinned to `engine`, or else to this coordinator's
+    /// own fingerprint for its scene ([`Store::own`]; unpinned when that is unknown).
     pub async fn create_planned(
         &self,
         plan: &CampaignPlan,
         spec_json: &str,
         name: Option<&str>,
         idempotency_key: Option<&str>,
+        engine: Option<&str>,
     ) -> Result<CampaignCreated> {
+        let engine = engine.or_else(|| self.own.engines.get(plan.kind).map(String::as_str));
         let jobs_total = plan.jobs.len() as u64;
         let internal = |e: serde_json::Error| Error::Internal(e.to_string());
         let mut tx = self.begin().await?;
@@ -74,6 +101,8 @@ impl Store {
                 max_attempts: self.max_attempts,
                 idempotency_key,
                 now,
+                engine,
+                commit: self.own.commit.as_deref(),
             },
         )
         .await?;
@@ -102,7 +131,7 @@ impl Store {
         insert_queued_jobs(&mut tx, &id.to_string(), seq, &plan.jobs, now).await?;
         tx.commit().await?;
         tracing::info!(campaign = %id, scene = plan.kind, jobs = jobs_total,
-            units_total = plan.units_total, "campaign created");
+            units_total = plan.units_total, engine, "campaign created");
         Ok(CampaignCreated {
             id,
             jobs: jobs_total,
@@ -272,6 +301,14 @@ impl Store {
             attempts: r.get::<i64, _>("attempts") as u32,
             error: r.get::<Option<String>, _>("last_error").unwrap_or_default(),
         });
+        let engine: Option<String> = c.get("engine");
+        let engine_seen = match &engine {
+            Some(fp) => Some(
+                self.engine_seen(&c.get::<String, _>("scene"), fp, now)
+                    .await?,
+            ),
+            None => None,
+        };
         Ok(CampaignStatus {
             id,
             name: c.get("name"),
@@ -285,6 +322,8 @@ impl Store {
             last_error,
             created_ms: c.get("created_ms"),
             scene,
+            engine,
+            engine_seen,
         })
     }
 
@@ -300,7 +339,29 @@ impl Store {
         } else {
             None
         };
-        scene.results(&c.get::<String, _>("spec"), cells, raw)
+        let body = scene.results(&c.get::<String, _>("spec"), cells, raw)?;
+        Ok(with_engine(
+            body,
+            c.get("engine"),
+            c.get::<Option<String>, _>("commit_id"),
+        ))
+    }
+
+    /// Whether a worker whose fingerprint for `scene` is `engine` claimed or reported since
+    /// one lease period before `now`.
+    async fn engine_seen(&self, scene: &str, engine: &str, now: i64) -> Result<bool> {
+        let path = format!("$.\"{scene}\"");
+        Ok(sqlx::query(
+            "SELECT 1 FROM workers WHERE last_seen_ms >= ?1
+               AND (json_extract(engines, ?2) = ?3 OR json_extract(engines, '$.\"*\"') = ?3)
+             LIMIT 1",
+        )
+        .bind(now - self.lease_ttl.as_millis() as i64)
+        .bind(path)
+        .bind(engine)
+        .fetch_optional(&self.read)
+        .await?
+        .is_some())
     }
 
     /// [`Store::results_json`] read as grit's own scenes' results.

@@ -40,6 +40,8 @@ const QUEUE: usize = 4096;
 pub(super) enum Op {
     Claim {
         worker: String,
+        /// The worker's fingerprints as a JSON object by scene kind (`*`: every scene).
+        engines: String,
     },
     Heartbeat {
         job_id: i64,
@@ -217,8 +219,8 @@ async fn apply(
     reap: bool,
 ) -> Result<Reply> {
     Ok(match op {
-        Op::Claim { worker } => Reply::Claimed(
-            apply_claim(tx, lease_ttl, worker, reap)
+        Op::Claim { worker, engines } => Reply::Claimed(
+            apply_claim(tx, lease_ttl, worker, engines, reap)
                 .await?
                 .map(Box::new),
         ),
@@ -261,7 +263,7 @@ async fn apply(
 /// Logs a request once it is committed.
 fn log_applied(op: &Op, reply: &Reply) {
     match (op, reply) {
-        (Op::Claim { worker }, Reply::Claimed(Some(job))) => {
+        (Op::Claim { worker, .. }, Reply::Claimed(Some(job))) => {
             tracing::debug!(job = job.job_id, worker, "job leased");
         }
         (Op::Complete { job_id, .. }, _) => tracing::debug!(job = job_id, "job done"),

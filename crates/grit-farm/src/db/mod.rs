@@ -89,6 +89,19 @@ pub struct Store {
     pub max_attempts: u32,
     /// The scenes whose jobs this store's coordinator runs.
     pub scenes: crate::scenes::SceneRegistry,
+    /// This coordinator's engine: new campaigns are pinned to it unless their spec names one.
+    pub own: OwnEngine,
+}
+
+/// A coordinator's own engine (`grit version --json`): the fingerprint of each scene it runs,
+/// by kind, and the commit it was built from. Empty, new campaigns are left unpinned, as
+/// campaigns before pins were.
+#[derive(Debug, Clone, Default)]
+pub struct OwnEngine {
+    /// Fingerprint of each scene, by kind.
+    pub engines: std::collections::BTreeMap<String, String>,
+    /// The commit of the build, `unknown` without git at build time.
+    pub commit: Option<String>,
 }
 
 /// When a commit counts as done, and so when a write is answered: SQLite's `synchronous`
@@ -158,6 +171,7 @@ impl Store {
             lease_ttl,
             max_attempts: max_attempts.max(1),
             scenes: Default::default(),
+            own: OwnEngine::default(),
         })
     }
 
@@ -272,6 +286,10 @@ pub(crate) struct NewCampaign<'a> {
     pub max_attempts: u32,
     pub idempotency_key: Option<&'a str>,
     pub now: i64,
+    /// The engine fingerprint the campaign is pinned to, if any.
+    pub engine: Option<&'a str>,
+    /// The commit of the grit that created it.
+    pub commit: Option<&'a str>,
 }
 
 /// Inserts the campaign row `c`; returns its rowid, the `seq` its jobs carry.
@@ -281,8 +299,8 @@ pub(crate) async fn insert_campaign(
 ) -> Result<i64> {
     Ok(sqlx::query(
         "INSERT INTO campaigns (id, name, spec, samples, units_total, max_attempts,
-                                idempotency_key, created_ms, scene)
-         VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING rowid",
+                                idempotency_key, created_ms, scene, engine, commit_id)
+         VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING rowid",
     )
     .bind(c.id.to_string())
     .bind(c.name)
@@ -293,6 +311,8 @@ pub(crate) async fn insert_campaign(
     .bind(c.idempotency_key)
     .bind(c.now)
     .bind(c.scene)
+    .bind(c.engine)
+    .bind(c.commit)
     .fetch_one(&mut **tx)
     .await?
     .get(0))

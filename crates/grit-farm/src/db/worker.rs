@@ -228,18 +228,50 @@ impl Store {
         Ok(n)
     }
 
-    /// Leases the next queued job to `worker`, or `None` when the queue is empty.
+    /// [`Store::claim_for`] a worker that runs this coordinator's own engine ([`Store::own`]),
+    /// as the local workers of `grit run` do.
     pub async fn claim(&self, worker: &str) -> Result<Option<ClaimedJob>> {
+        let own = serde_json::to_string(&self.own.engines).expect("a map of strings serialises");
+        self.claim_for(worker, &own).await
+    }
+
+    /// Leases the next queued job of a campaign that is unpinned or pinned to the worker's
+    /// fingerprint for its scene; `engines` is a JSON object from scene kind to fingerprint,
+    /// `*` standing for every scene (`WorkerEngine::to_json`).
+    pub async fn claim_for(&self, worker: &str, engines: &str) -> Result<Option<ClaimedJob>> {
         match self
             .group
             .apply(Op::Claim {
                 worker: worker.to_owned(),
+                engines: engines.to_owned(),
             })
             .await?
         {
             Reply::Claimed(job) => job.map(|j| j.claimed()).transpose(),
             _ => Err(mismatch()),
         }
+    }
+
+    /// Why a worker with fingerprints `engines` (as [`Store::claim`] takes them) got no job
+    /// while jobs are queued: the first queued campaign pinned to another engine, named with
+    /// its fingerprint; `None` when nothing is queued.
+    pub async fn why_no_job(&self, engines: &str) -> Result<Option<String>> {
+        let row = sqlx::query(
+            "SELECT c.id, c.scene, c.engine FROM jobs j JOIN campaigns c ON c.id = j.campaign_id
+             WHERE j.state = 'queued' ORDER BY j.campaign_seq LIMIT 1",
+        )
+        .fetch_optional(&self.read)
+        .await?;
+        Ok(row.map(|r| {
+            let (id, scene, engine): (String, String, Option<String>) =
+                (r.get(0), r.get(1), r.get(2));
+            format!(
+                "jobs are queued, but campaign {id} is pinned to {scene} engine {} and this \
+                 worker runs {engines}: start a worker built from the campaign's commit, or \
+                 resubmit the campaign for this engine",
+                engine.as_deref().unwrap_or("(none)")
+            )
+        }))
     }
 
     /// Renews the lease, stores the finished units and an optional
@@ -324,34 +356,48 @@ pub(super) async fn apply_claim(
     tx: &mut Transaction<'static, Sqlite>,
     lease_ttl: Duration,
     worker: &str,
+    engines: &str,
     sweep: bool,
 ) -> Result<Option<Leased>> {
     let now = now_ms();
     if sweep {
         reap(tx, now).await?;
     }
-    // Every claim counts as a sign of life, an empty queue's too: idle workers are listed.
+    // Every claim counts as a sign of life, an empty queue's too: idle workers are listed,
+    // with the engines they run, so a queue waiting for an engine nobody has shows.
     sqlx::query(
-        "INSERT INTO workers (name, first_seen_ms, last_seen_ms) VALUES (?1, ?2, ?2)
-         ON CONFLICT (name) DO UPDATE SET last_seen_ms = excluded.last_seen_ms",
+        "INSERT INTO workers (name, first_seen_ms, last_seen_ms, engines) VALUES (?1, ?2, ?2, ?3)
+         ON CONFLICT (name) DO UPDATE SET last_seen_ms = excluded.last_seen_ms,
+                                          engines = excluded.engines",
     )
     .bind(worker)
     .bind(now)
+    .bind(engines)
     .execute(&mut **tx)
     .await?;
     let lease = Uuid::new_v4();
     let expires = now + lease_ttl.as_millis() as i64;
+    // The first queued job of a campaign that is unpinned or pinned to the worker's
+    // fingerprint for its scene; the lease records that fingerprint for the units.
     let Some(r) = sqlx::query(
-        "UPDATE jobs SET state = 'leased', lease_id = ?, worker = ?, lease_expires_ms = ?,
-                         updated_ms = ?
-         WHERE id = (SELECT id FROM jobs WHERE state = 'queued'
-                     ORDER BY campaign_seq, sample_index, cell_index LIMIT 1)
+        "UPDATE jobs SET state = 'leased', lease_id = ?1, worker = ?2, lease_expires_ms = ?3,
+                         updated_ms = ?4,
+                         engine = (SELECT coalesce(json_extract(?5, '$.\"' || c.scene || '\"'),
+                                                   json_extract(?5, '$.\"*\"'))
+                                   FROM campaigns c WHERE c.id = jobs.campaign_id)
+         WHERE id = (SELECT j.id FROM jobs j JOIN campaigns c ON c.id = j.campaign_id
+                     WHERE j.state = 'queued'
+                       AND (c.engine IS NULL
+                            OR c.engine = coalesce(json_extract(?5, '$.\"' || c.scene || '\"'),
+                                                   json_extract(?5, '$.\"*\"')))
+                     ORDER BY j.campaign_seq, j.sample_index, j.cell_index LIMIT 1)
          RETURNING id, campaign_id, cell_index, sample_index, seed, units_planned, units_done",
     )
     .bind(lease.to_string())
     .bind(worker)
     .bind(expires)
     .bind(now)
+    .bind(engines)
     .fetch_optional(&mut **tx)
     .await?
     else {
@@ -533,6 +579,8 @@ struct Held {
     has_checkpoint: bool,
     /// The job's scene (`campaigns.scene`).
     scene: String,
+    /// The lease holder's engine fingerprint for that scene, stamped on its units.
+    engine: Option<String>,
 }
 
 async fn check_lease(
@@ -551,7 +599,7 @@ async fn check_lease(
                 k.target_sem_rel AS target_sem_rel,
                 EXISTS (SELECT 1 FROM checkpoints c WHERE c.job_id = j.id) AS has_checkpoint,
                 (SELECT p.scene FROM campaigns p WHERE p.id = j.campaign_id) AS scene,
-                k.params AS params
+                j.engine AS engine, k.params AS params
          FROM jobs j JOIN cells k ON k.campaign_id = j.campaign_id AND k.cell_index = j.cell_index
          WHERE j.id = ?",
     )
@@ -584,6 +632,7 @@ async fn check_lease(
         cell: stored_cell(&r)?,
         has_checkpoint: r.get("has_checkpoint"),
         scene: r.get("scene"),
+        engine: r.get("engine"),
     })
 }
 
@@ -720,7 +769,7 @@ async fn store_units(
         .chunks(UNIT_ROWS_PER_INSERT)
     {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
-            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms) ",
+            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms, engine) ",
         );
         qb.push_values(chunk, |mut b, (&i, &lost)| {
             let (n, json) = &units.rows[i];
@@ -728,7 +777,8 @@ async fn store_units(
                 .push_bind(*n as i64)
                 .push_bind(lost)
                 .push_bind(json.as_str())
-                .push_bind(now);
+                .push_bind(now)
+                .push_bind(held.engine.as_deref());
         });
         qb.build().execute(&mut **tx).await?;
     }

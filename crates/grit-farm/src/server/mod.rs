@@ -23,7 +23,7 @@ pub mod worker;
 pub mod workers;
 
 pub use auth::Secret;
-pub use worker::ApiJson;
+pub use worker::{ApiJson, NO_JOB_HEADER};
 
 /// Largest campaign spec accepted (bytes); larger gets 413.
 pub const DEFAULT_SUBMIT_LIMIT: usize = 1 << 20;
@@ -61,6 +61,8 @@ pub struct AppState {
     pub store: Store,
     /// Tokens and limits.
     pub config: Arc<Config>,
+    /// Workers already told in the log why they get no job, so each is told once.
+    pub told: Arc<std::sync::Mutex<std::collections::HashSet<String>>>,
 }
 
 /// The 422 for a query parameter an endpoint does not take, listing the ones it does.
@@ -236,6 +238,7 @@ pub async fn start(listen: &str, store: Store, config: Config) -> std::io::Resul
     let state = AppState {
         store: store.clone(),
         config: Arc::new(config),
+        told: Default::default(),
     };
     let router = app(state);
     let task = tokio::spawn(async move {

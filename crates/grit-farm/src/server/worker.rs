@@ -168,7 +168,14 @@ where
             if inner.is_data() && path != "." {
                 Error::invalid(path, inner.to_string())
             } else if inner.is_data() {
-                Error::invalid("(body)", inner.to_string())
+                // A missing field is reported at the body; name the field itself.
+                let message = inner.to_string();
+                let field = message
+                    .strip_prefix("missing field `")
+                    .and_then(|rest| rest.split('`').next())
+                    .unwrap_or("(body)")
+                    .to_string();
+                Error::invalid(field, message)
             } else {
                 malformed(inner)
             }
@@ -184,9 +191,15 @@ fn job_id(raw: &str) -> Result<i64> {
         .map_err(|_| Error::NotFound(format!("job {raw} (job ids are integers)")))
 }
 
-/// Leases the next job; 204 when the queue is empty.
+/// The header of a 204 claim that says why queued jobs were not leased.
+pub const NO_JOB_HEADER: &str = "grit-no-job";
+
+/// Leases the next job of a campaign pinned to the worker's engine; 204 when there is none,
+/// with [`NO_JOB_HEADER`] saying why when jobs are queued for other engines.
 #[utoipa::path(post, path = "/api/v1/worker/claim", request_body = ClaimRequest,
-    responses((status = 200, body = ClaimedJob), (status = 204, description = "no job queued"), (status = 401)),
+    responses((status = 200, body = ClaimedJob),
+        (status = 204, description = "no job for this worker's engine queued"), (status = 401),
+        (status = 422, body = ErrorBody, description = "no or a malformed `worker` or `engine`")),
     security(("worker_token" = [])))]
 async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -> Result<Response> {
     if req.worker.trim().is_empty() || req.worker.len() > 200 {
@@ -195,10 +208,27 @@ async fn claim(State(s): State<AppState>, ApiJson(req): ApiJson<ClaimRequest>) -
             "must be 1 to 200 characters, not all blank",
         ));
     }
-    Ok(match s.store.claim(&req.worker).await? {
-        Some(job) => Json(job).into_response(),
-        None => StatusCode::NO_CONTENT.into_response(),
-    })
+    let engines = req
+        .engine
+        .to_json()
+        .map_err(|(field, rule)| Error::invalid(field, rule))?;
+    if let Some(job) = s.store.claim_for(&req.worker, &engines).await? {
+        return Ok(Json(job).into_response());
+    }
+    let mut answer = StatusCode::NO_CONTENT.into_response();
+    if let Some(why) = s.store.why_no_job(&engines).await? {
+        if s.told
+            .lock()
+            .expect("the told set")
+            .insert(req.worker.clone())
+        {
+            tracing::warn!(worker = %req.worker, "{why}");
+        }
+        if let Ok(v) = axum::http::HeaderValue::from_str(&why) {
+            answer.headers_mut().insert(NO_JOB_HEADER, v);
+        }
+    }
+    Ok(answer)
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/heartbeat", params(("job_id" = i64, Path)),

@@ -195,6 +195,13 @@ pub struct CampaignResults {
     /// was created (the spec does not set them: they are the defaults of that day's grit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub numerics: Option<crate::impact::Numerics>,
+    /// The engine fingerprint the farm pinned the campaign to, which computed every unit;
+    /// absent in files from before pins and outside a farm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub engine: Option<String>,
+    /// The commit of the grit that created the campaign, beside `engine`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub commit: Option<String>,
 }
 
 impl CampaignResults {
@@ -423,6 +430,8 @@ pub fn aggregate_campaign(
         spec: None,
         grit_version: Some(env!("CARGO_PKG_VERSION").to_string()),
         numerics: None,
+        engine: None,
+        commit: None,
     };
     results.steady = results.cells_steady();
     Ok(results)

@@ -323,6 +323,12 @@ impl Scene for Sample {
     type Params = ImpactParams;
     type Record = ImpactRecord;
 
+    fn engine() -> Result<String, SceneError> {
+        static FINGERPRINT: std::sync::OnceLock<Result<String, String>> =
+            std::sync::OnceLock::new();
+        crate::fingerprint::once(&FINGERPRINT, crate::fingerprint::impact_engine)
+    }
+
     fn start(params: &ImpactParams, seed: u64) -> Result<Sample, SceneError> {
         Sample::new(params.clone(), seed).map_err(|e| SceneError::Run(e.to_string()))
     }

@@ -162,6 +162,10 @@ pub struct CampaignSpec {
     /// Permit fewer than 21 impacts per sample, for smoke tests of the farm; such samples
     /// give no last-20 slope, so their cells report no erosion.
     pub allow_short_samples: bool,
+    /// The engine fingerprint the campaign runs on ([`crate::campaign::check_engine`]);
+    /// absent, a farm pins the campaign to its coordinator's own.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engine: Option<String>,
 }
 
 impl Default for CampaignSpec {
@@ -185,6 +189,7 @@ impl Default for CampaignSpec {
             surface_depth_dg: p.surface_depth_dg,
             settle_fraction: p.settle_fraction,
             allow_short_samples: false,
+            engine: None,
         }
     }
 }
@@ -247,6 +252,7 @@ impl CampaignSpec {
 
     /// Checks every rule; the error names the field and the rule.
     pub fn validate(&self) -> Result<(), SpecError> {
+        crate::campaign::check_engine(self.engine.as_deref())?;
         if let Some(n) = &self.name {
             if n.len() > 200 {
                 return Err(err("name", "must be at most 200 characters"));

@@ -251,6 +251,13 @@ pub struct JetCampaignResults {
     /// Version of grit that aggregated these results.
     #[serde(default)]
     pub grit_version: Option<String>,
+    /// The engine fingerprint the farm pinned the campaign to, which computed every unit;
+    /// absent in files from before pins and outside a farm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub engine: Option<String>,
+    /// The commit of the grit that created the campaign, beside `engine`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub commit: Option<String>,
 }
 
 impl JetCampaignResults {
@@ -650,6 +657,8 @@ pub fn aggregate_jet_campaign(
         cells,
         spec: None,
         grit_version: Some(env!("CARGO_PKG_VERSION").to_string()),
+        engine: None,
+        commit: None,
     })
 }
 
@@ -863,6 +872,8 @@ mod tests {
                 cells: vec![self.clone()],
                 spec: None,
                 grit_version: None,
+                engine: None,
+                commit: None,
             }
             .unsteady_warnings()
             .is_empty()

@@ -429,6 +429,12 @@ impl Scene for JetRun {
     type Params = JetParams;
     type Record = JetSlice;
 
+    fn engine() -> Result<String, SceneError> {
+        static FINGERPRINT: std::sync::OnceLock<Result<String, String>> =
+            std::sync::OnceLock::new();
+        crate::fingerprint::once(&FINGERPRINT, crate::fingerprint::jet_engine)
+    }
+
     fn start(params: &JetParams, seed: u64) -> Result<JetRun, SceneError> {
         JetRun::new(params.clone(), seed).map_err(|e| SceneError::Run(e.to_string()))
     }

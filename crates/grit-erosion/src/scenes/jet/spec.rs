@@ -124,6 +124,10 @@ pub struct JetCampaignSpec {
     pub dem: DemParams,
     /// The grain–target penalty contact.
     pub penalty: PenaltyParams,
+    /// The engine fingerprint the campaign runs on ([`crate::campaign::check_engine`]);
+    /// absent, a farm pins the campaign to its coordinator's own.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engine: Option<String>,
 }
 
 impl Default for JetCampaignSpec {
@@ -154,6 +158,7 @@ impl Default for JetCampaignSpec {
             drag_switch_porosity: p.drag_switch_porosity,
             dem: p.dem,
             penalty: p.penalty,
+            engine: None,
         }
     }
 }
@@ -252,6 +257,7 @@ impl JetCampaignSpec {
 
     /// Checks every rule; the error names the field and the rule.
     pub fn validate(&self) -> Result<(), SpecError> {
+        crate::campaign::check_engine(self.engine.as_deref())?;
         if self.scene != Scene::Jet {
             return Err(err("scene", "must be \"jet\" in a jet campaign spec"));
         }
