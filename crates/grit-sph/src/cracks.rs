@@ -216,7 +216,7 @@ mod tests {
             for i in 0..10 {
                 pos.push(Vector::new(i as f64 * S, -(j as f64) * S));
                 let vertical = i == 2 && j < 6;
-                let diagonal = i >= 5 && i < 9 && j == i - 3;
+                let diagonal = (5..9).contains(&i) && j == i - 3;
                 dmg.push(vertical || diagonal);
             }
         }
