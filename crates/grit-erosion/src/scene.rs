@@ -4,6 +4,10 @@
 //! [`Scene`] trait; each scene (`crate::scenes`) implements it.
 
 use grit_sph::InputError;
+
+use std::collections::BTreeMap;
+
+use crate::campaign::{CellRecords, NextStep, StoredCell, StoredJob, UnitMasses};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 use serde::de::DeserializeOwned;
@@ -16,6 +20,8 @@ pub trait Scene: Sized + Send + Sync + 'static {
     const KIND: &'static str;
     /// The unit, in words, for logs and errors (`impact`, `slice`).
     const UNIT: &'static str;
+    /// The key a raw results listing gives a job's records under (`impacts`, `slices`).
+    const RECORDS: &'static str = "units";
     /// Whether a cancelled unit leaves the state mid-unit. Such a scene is checkpointed after
     /// every unit and hands back the last of those when it stops; otherwise the state after
     /// the last finished unit is always at hand and checkpoints are taken every few units.
@@ -50,6 +56,33 @@ pub trait Scene: Sized + Send + Sync + 'static {
         record: &Self::Record,
         lost_before_kg_m: f64,
     ) -> Result<f64, InputError>;
+
+    /// The results endpoint's JSON of a campaign from its stored spec (`spec`, JSON) and its
+    /// cells as they stand now with their records; `raw`, when asked for, lists every job's
+    /// records ([`crate::campaign::results_json`] writes the body).
+    fn results(
+        spec: &str,
+        cells: Vec<CellRecords<Self::Record>>,
+        raw: Option<Vec<StoredJob<Self::Record>>>,
+    ) -> Result<String, SceneError>;
+
+    /// What a cell's growth ([`Scene::next_step`]) reads of a record, which a farm stores
+    /// beside it so that judging a cell need not parse every record; `None` for a scene whose
+    /// cells do not grow.
+    fn masses(_record: &Self::Record) -> Option<UnitMasses> {
+        None
+    }
+
+    /// What a farm does with `cell` once every sample has its planned units, from its growth
+    /// rules and its samples' units ([`Scene::masses`], in unit order, by sample)
+    /// (`docs/erosion.md`, "Extending a cell"). A scene without such rules leaves every cell
+    /// as planned.
+    fn next_step(
+        _cell: &StoredCell,
+        _samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep, SceneError> {
+        Ok(NextStep::Final)
+    }
 }
 
 /// Something done with a scene picked at run time by its [`Scene::KIND`], as the farm does

@@ -1,5 +1,6 @@
 //! The farm's view of the scenes it runs: what the coordinator does with a job's reported
-//! units and uploaded checkpoints, for a scene it knows only by its stored kind. Built once
+//! units and uploaded checkpoints, a campaign's stored records and a finished cell, for a
+//! scene it knows only by its stored kind. Built once
 //! from a [`SceneSet`] (grit's own [`grit_erosion::Scenes`] by default), so a new scene
 //! reaches the farm without a change to it.
 
@@ -7,6 +8,7 @@ use std::collections::BTreeMap;
 use std::marker::PhantomData;
 use std::sync::Arc;
 
+use grit_erosion::campaign::{CellRecords, NextStep, StoredCell, StoredJob, UnitMasses};
 use grit_erosion::{Scene, SceneSet, SceneVisitor};
 use serde_json::Value;
 
@@ -29,6 +31,51 @@ pub trait FarmScene: Send + Sync {
         params: &str,
         seed: u64,
     ) -> std::result::Result<CheckpointBytes, CheckpointError>;
+    /// [`Scene::results`] of a campaign whose spec is `spec`, its records as stored (JSON).
+    fn results(
+        &self,
+        spec: &str,
+        cells: Vec<CellRecords<String>>,
+        raw: Option<Vec<StoredJob<String>>>,
+    ) -> Result<String>;
+    /// [`Scene::masses`] of a record as stored (JSON).
+    fn masses(&self, record: &str) -> Result<Option<UnitMasses>>;
+    /// [`Scene::next_step`] of a cell whose samples have their planned units.
+    fn next_step(
+        &self,
+        cell: &StoredCell,
+        samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep>;
+}
+
+/// A stored record (JSON) as scene `S`'s.
+fn record<S: Scene>(text: &str) -> Result<S::Record> {
+    serde_json::from_str(text).map_err(|e| Error::Internal(format!("stored unit record: {e}")))
+}
+
+/// A stored cell's records (JSON) as scene `S`'s.
+fn cell_records<S: Scene>(c: CellRecords<String>) -> Result<CellRecords<S::Record>> {
+    let samples = c
+        .samples
+        .into_iter()
+        .map(|(sample, texts)| {
+            Ok((
+                sample,
+                texts
+                    .iter()
+                    .map(|t| record::<S>(t))
+                    .collect::<Result<_>>()?,
+            ))
+        })
+        .collect::<Result<_>>()?;
+    Ok(CellRecords {
+        cell: c.cell,
+        samples,
+    })
+}
+
+fn scene_error(e: grit_erosion::SceneError) -> Error {
+    Error::Internal(e.to_string())
 }
 
 /// [`FarmScene`] of scene `S`.
@@ -66,6 +113,50 @@ impl<S: Scene> FarmScene for Ops<S> {
             rule: format!("the job's stored parameters do not read: {e}"),
         })?;
         verify_upload::<S>(c, job_id, &params, seed).map(|(_, bytes)| bytes)
+    }
+
+    fn results(
+        &self,
+        spec: &str,
+        cells: Vec<CellRecords<String>>,
+        raw: Option<Vec<StoredJob<String>>>,
+    ) -> Result<String> {
+        let cells = cells
+            .into_iter()
+            .map(cell_records::<S>)
+            .collect::<Result<_>>()?;
+        let raw = raw
+            .map(|jobs| {
+                jobs.into_iter()
+                    .map(|j| {
+                        Ok(StoredJob {
+                            records: j
+                                .records
+                                .iter()
+                                .map(|t| record::<S>(t))
+                                .collect::<Result<_>>()?,
+                            cell: j.cell,
+                            sample: j.sample,
+                            seed: j.seed,
+                            state: j.state,
+                        })
+                    })
+                    .collect::<Result<_>>()
+            })
+            .transpose()?;
+        S::results(spec, cells, raw).map_err(scene_error)
+    }
+
+    fn masses(&self, text: &str) -> Result<Option<UnitMasses>> {
+        Ok(S::masses(&record::<S>(text)?))
+    }
+
+    fn next_step(
+        &self,
+        cell: &StoredCell,
+        samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep> {
+        S::next_step(cell, samples).map_err(scene_error)
     }
 }
 

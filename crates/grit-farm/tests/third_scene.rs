@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use grit_erosion::campaign::{CampaignPlan, PlannedCell};
+use grit_erosion::campaign::{results_json, CampaignPlan, CellRecords, PlannedCell, StoredJob};
 use grit_erosion::{Scene, SceneError, SceneSet, SceneVisitor, Scenes};
 use grit_farm::api::CampaignState;
 use grit_farm::db::Reported;
@@ -97,6 +97,22 @@ impl Scene for Drip {
         }
         Ok(lost_before_kg_m + record.loss)
     }
+
+    /// Each cell's index and its samples' total losses.
+    fn results(
+        _spec: &str,
+        cells: Vec<CellRecords<Drop>>,
+        raw: Option<Vec<StoredJob<Drop>>>,
+    ) -> Result<String, SceneError> {
+        let totals: Vec<(u32, Vec<f64>)> = cells
+            .iter()
+            .map(|c| {
+                let lost = c.samples.values().map(|d| d.iter().map(|x| x.loss).sum());
+                (c.cell.index, lost.collect())
+            })
+            .collect();
+        results_json::<Drip, _>(&serde_json::json!({ "cells": totals }), raw.as_deref())
+    }
 }
 
 /// grit's scenes and the drip.
@@ -187,6 +203,11 @@ async fn a_scene_the_farm_does_not_name_runs_on_it() {
         assert_eq!((c.angle_deg, c.shape.as_deref()), (None, None));
         assert_eq!(c.samples_done, 3);
     }
+    // Its results are the scene's own, served through the farm's one results path.
+    let results = client.results_value(created.id, true).await.unwrap();
+    assert_eq!(results["cells"][1][0], 1, "{results}");
+    assert_eq!(results["cells"][1][1].as_array().unwrap().len(), 3);
+    assert_eq!(results["raw"][5]["units"].as_array().unwrap().len(), 7);
 
     // The scene's own rule on its records holds on the farm, the field named as a unit's.
     let second = store

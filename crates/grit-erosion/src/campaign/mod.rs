@@ -1,7 +1,8 @@
 //! What every scene's campaign shares (`docs/design.md`, "Campaign spec"): the errors that
 //! name a spec's field and rule, sweeps of one or many values, the material, the limits on a
 //! campaign's size, and the job seeds; the rules that grow a cell (`plan`); the spec of any
-//! scene (`AnySpec`). Each scene's own spec lives with the scene (`crate::scenes::*::spec`).
+//! scene (`AnySpec`); a campaign as a farm stored it, handed back to its scene (`stored`).
+//! Each scene's own spec lives with the scene (`crate::scenes::*::spec`).
 //!
 //! # Job seeds
 //! A job's seed is a pure function of (campaign seed, cell index, sample index):
@@ -24,12 +25,14 @@ use serde::{Serialize, Serializer};
 mod any;
 pub(crate) mod json;
 mod plan;
-pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts, JobSpec};
-pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, JetJob, Scene};
+mod stored;
+pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts};
+pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, Scene};
 pub use any::{AnySpec, CampaignPlan, PlannedCell};
 pub use plan::{
     annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
 };
+pub use stored::{results_json, CellRecords, StoredCell, StoredJob, UnitMasses};
 
 /// Fewest impacts a sample may be planned with: the slope window (20) plus one.
 pub const MIN_IMPACTS: u32 = 21;

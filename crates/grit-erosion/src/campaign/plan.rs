@@ -401,7 +401,8 @@ mod tests {
         s.validate().unwrap();
         assert_eq!(s.samples.initial(), 3);
         assert_eq!(s.samples.max(), 40);
-        assert_eq!(s.expand().unwrap().len(), 24 * 3);
+        let plan = crate::campaign::AnySpec::Impact(s.clone()).plan().unwrap();
+        assert_eq!(plan.jobs.len(), 24 * 3);
         let back = CampaignSpec::from_json(&serde_json::to_string(&s).unwrap()).unwrap();
         assert_eq!(back, s);
     }

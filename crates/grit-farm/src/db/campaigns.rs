@@ -3,8 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{AnySpec, CampaignPlan, CampaignSpec, Scene};
-use grit_erosion::{aggregate_campaign, Impact, ImpactRecord, SampleInput};
+use grit_erosion::campaign::{AnySpec, CampaignPlan, CampaignSpec, Scene, StoredJob};
 use sqlx::Row;
 use uuid::Uuid;
 
@@ -13,17 +12,9 @@ use super::{
 };
 use crate::api::{
     AnyResults, CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress,
-    JobCounts, JobError, JobInfo, JobState, RawSample, ResultsResponse,
+    JobCounts, JobError, JobInfo, JobState,
 };
 use crate::error::{Error, Result};
-
-/// Which job a set of stored records belongs to.
-pub(super) struct JobKey {
-    pub cell: u32,
-    pub sample: u32,
-    pub seed: u64,
-    pub state: String,
-}
 
 /// Window over which the impact rate (and so the ETA) is measured.
 const RATE_WINDOW_MS: i64 = 120_000;
@@ -297,103 +288,30 @@ impl Store {
         })
     }
 
-    /// Aggregated results of a campaign of either scene (partial while jobs remain); with
-    /// `raw`, every sample's impacts or slices.
-    pub async fn results_any(&self, id: Uuid, raw: bool) -> Result<AnyResults> {
+    /// The results JSON the results endpoint serves (partial while jobs remain; with `raw`,
+    /// every job's records), written by the campaign's scene from its stored spec, its cells
+    /// as they stand now and their records.
+    pub async fn results_json(&self, id: Uuid, raw: bool) -> Result<String> {
         let c = self.campaign_row(id).await?;
-        match scene_of(&c) {
-            Scene::Impact => Ok(AnyResults::Impact(self.results(id, raw).await?)),
-            Scene::Jet => {
-                let spec_text: String = c.get("spec");
-                Ok(AnyResults::Jet(
-                    self.jet_results(id, &spec_text, raw).await?,
-                ))
-            }
-        }
-    }
-
-    /// Aggregated results of an impact campaign (partial while jobs remain); with `raw`, every
-    /// sample's series. A jet campaign's are [`Store::results_any`]'s.
-    pub async fn results(&self, id: Uuid, raw: bool) -> Result<ResultsResponse> {
-        let c = self.campaign_row(id).await?;
-        if scene_of(&c) == Scene::Jet {
-            return Err(Error::Conflict(format!(
-                "campaign {id} runs the jet scene: its results are jet results"
-            )));
-        }
-        let spec_text: String = c.get("spec");
-        let spec = CampaignSpec::from_json(&spec_text)?;
-        let cells = spec.cells()?;
-        // An impact record's grain mass and loss are all the aggregation reads of it.
-        let per_cell = self.cell_records::<Impact>(id, cells.len()).await?;
-        // Cells that grew are planned as they are now, not as the spec first planned them.
-        let plans = self.cell_plans(id).await?;
-        let inputs: Vec<_> = cells
-            .iter()
-            .zip(per_cell)
-            .zip(&plans)
-            .map(|((cell, samples), plan)| {
-                let mut input = cell.input(
-                    plan.samples,
-                    samples
-                        .into_iter()
-                        .map(|(sample, impacts)| SampleInput { sample, impacts })
-                        .collect(),
-                );
-                input.planned_impacts = plan.impacts as usize;
-                input
-            })
-            .collect();
-        // The stored spec is the parsed one written back, every default filled in, so a
-        // reader of the results can rerun exactly this campaign.
-        let spec_value: serde_json::Value = serde_json::from_str(&spec_text)
-            .map_err(|e| Error::Internal(format!("stored spec: {e}")))?;
-        let mut results = aggregate_campaign(&inputs, grit_erosion::SLOPE_WINDOW)
-            .map_err(|e| Error::Internal(format!("aggregation: {e}")))?
-            .with_spec(spec_value);
-        // The cells' stored scenes, not today's defaults, say how the impacts ran.
-        let params: Option<String> = sqlx::query_scalar(
-            "SELECT params FROM cells WHERE campaign_id = ? ORDER BY cell_index LIMIT 1",
-        )
-        .bind(id.to_string())
-        .fetch_optional(&self.read)
-        .await?;
-        if let Some(p) = params {
-            let p: grit_erosion::ImpactParams = serde_json::from_str(&p)
-                .map_err(|e| Error::Internal(format!("stored cell scene: {e}")))?;
-            results.numerics = Some(p.numerics);
-        }
-        for (cell, plan) in results.cells.iter_mut().zip(&plans) {
-            grit_erosion::campaign::annotate(cell, plan.until, plan.target);
-        }
+        let scene = self.scenes.get(&c.get::<String, _>("scene"))?;
+        let cells = self.cell_records(id, self.stored_cells(id).await?).await?;
         let raw = if raw {
-            Some(self.raw_series(id).await?)
+            Some(self.job_records(id).await?)
         } else {
             None
         };
-        Ok(ResultsResponse { results, raw })
+        scene.results(&c.get::<String, _>("spec"), cells, raw)
     }
 
-    async fn raw_series(&self, id: Uuid) -> Result<Vec<RawSample>> {
-        let jobs = self.job_records::<ImpactRecord>(id).await?;
-        Ok(jobs
-            .into_iter()
-            .map(|(j, impacts)| RawSample {
-                cell: j.cell,
-                sample: j.sample,
-                seed: j.seed,
-                state: j.state,
-                impacts,
-            })
-            .collect())
+    /// [`Store::results_json`] read as grit's own scenes' results.
+    pub async fn results_any(&self, id: Uuid, raw: bool) -> Result<AnyResults> {
+        serde_json::from_str(&self.results_json(id, raw).await?)
+            .map_err(|e| Error::Internal(format!("results of campaign {id}: {e}")))
     }
 
-    /// Every job of campaign `id` in cell and sample order, with the records of the units it
-    /// stored, in order, parsed as `T`.
-    pub(super) async fn job_records<T: serde::de::DeserializeOwned>(
-        &self,
-        id: Uuid,
-    ) -> Result<Vec<(JobKey, Vec<T>)>> {
+    /// Every job of campaign `id` in cell and sample order, with the records (JSON) of the
+    /// units it stored, in order.
+    async fn job_records(&self, id: Uuid) -> Result<Vec<StoredJob<String>>> {
         let jobs = sqlx::query(
             "SELECT id, cell_index, sample_index, seed, state FROM jobs
              WHERE campaign_id = ? ORDER BY cell_index, sample_index",
@@ -408,25 +326,18 @@ impl Store {
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let mut records: BTreeMap<i64, Vec<T>> = BTreeMap::new();
+        let mut records: BTreeMap<i64, Vec<String>> = BTreeMap::new();
         for r in rows {
-            let rec: T = serde_json::from_str(&r.get::<String, _>(1))
-                .map_err(|e| Error::Internal(format!("stored unit record: {e}")))?;
-            records.entry(r.get(0)).or_default().push(rec);
+            records.entry(r.get(0)).or_default().push(r.get(1));
         }
         Ok(jobs
             .iter()
-            .map(|j| {
-                let key = JobKey {
-                    cell: j.get::<i64, _>("cell_index") as u32,
-                    sample: j.get::<i64, _>("sample_index") as u32,
-                    seed: j.get::<i64, _>("seed") as u64,
-                    state: j.get("state"),
-                };
-                (
-                    key,
-                    records.remove(&j.get::<i64, _>("id")).unwrap_or_default(),
-                )
+            .map(|j| StoredJob {
+                cell: j.get::<i64, _>("cell_index") as u32,
+                sample: j.get::<i64, _>("sample_index") as u32,
+                seed: j.get::<i64, _>("seed") as u64,
+                state: j.get("state"),
+                records: records.remove(&j.get::<i64, _>("id")).unwrap_or_default(),
             })
             .collect())
     }

@@ -1,104 +1,98 @@
-//! Cells that grow with their results (`docs/erosion.md`, "Extending a cell"): when the last
-//! job of such a cell completes, the same transaction assesses the cell from its stored
-//! impacts and either plans every sample for more impacts (they resume from the checkpoint
-//! kept after their last impact), adds samples, or finishes the cell and drops its kept
-//! checkpoints. The rule itself is grit-erosion's [`next_step`].
+//! Cells as stored, and cells that grow with their results (`docs/erosion.md`, "Extending a
+//! cell"): when the last job of such a cell completes, the same transaction hands the cell
+//! and its units' stored masses to its scene ([`FarmScene::next_step`]), and either plans every
+//! sample for more units (they resume from the checkpoint kept after their last unit), adds
+//! samples, or finishes the cell and drops its kept checkpoints.
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{job_seed, next_step, CampaignSpec, NextStep, TargetSem, UntilSteady};
-use grit_erosion::{aggregate_cell, CellInput, Impact, SampleInput, SLOPE_WINDOW};
+use grit_erosion::campaign::{job_seed, NextStep, StoredCell, TargetSem, UnitMasses, UntilSteady};
+use serde::Deserialize;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
 use super::{insert_queued_jobs, NewJob, Store};
 use crate::error::{Error, Result};
+use crate::scenes::FarmScene;
 
-/// A cell's current plan and the rules that may grow it.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct CellPlan {
-    /// Impacts every sample is planned for now.
-    pub impacts: u32,
-    /// Samples the cell has now.
-    pub samples: u32,
-    /// Impacts grow until steady, if set.
-    pub until: Option<UntilSteady>,
-    /// Samples grow until the error bar is small, if set.
-    pub target: Option<TargetSem>,
+/// The cell in row `r`, whose columns carry the names of [`CELL_COLUMNS`]: the one source of
+/// a cell as it stands now, grown or not.
+pub(super) fn stored_cell(r: &sqlx::sqlite::SqliteRow) -> Result<StoredCell> {
+    let units = r.get::<i64, _>("units") as u32;
+    let samples = r.get::<i64, _>("samples") as u32;
+    let until_steady = match (
+        r.get::<Option<i64>, _>("units_max"),
+        r.get::<Option<i64>, _>("units_step"),
+    ) {
+        (Some(max), Some(step)) => Some(UntilSteady {
+            min: units.min(max as u32),
+            max: max as u32,
+            step: step as u32,
+        }),
+        _ => None,
+    };
+    let target_sem = match (
+        r.get::<Option<f64>, _>("target_sem_rel"),
+        r.get::<Option<i64>, _>("samples_max"),
+    ) {
+        (Some(t), Some(max)) => Some(TargetSem {
+            target_sem_rel: t,
+            min: samples.min(max as u32),
+            max: max as u32,
+        }),
+        _ => None,
+    };
+    let swept = serde_json::from_str(r.get::<&str, _>("swept"))
+        .map_err(|e| Error::Internal(format!("stored swept values: {e}")))?;
+    Ok(StoredCell {
+        index: r.get::<i64, _>("cell_index") as u32,
+        angle_deg: r.get("angle_deg"),
+        shape: r.get("shape"),
+        swept,
+        params: r.get("params"),
+        units,
+        samples,
+        until_steady,
+        target_sem,
+    })
 }
 
-impl CellPlan {
-    /// The plan in row `r`, whose columns carry the names of [`PLAN_COLUMNS`].
-    pub fn from_row(r: &sqlx::sqlite::SqliteRow) -> CellPlan {
-        let impacts = r.get::<i64, _>("units") as u32;
-        let samples = r.get::<i64, _>("samples") as u32;
-        let until = match (
-            r.get::<Option<i64>, _>("units_max"),
-            r.get::<Option<i64>, _>("units_step"),
-        ) {
-            (Some(max), Some(step)) => Some(UntilSteady {
-                min: impacts.min(max as u32),
-                max: max as u32,
-                step: step as u32,
-            }),
-            _ => None,
-        };
-        let target = match (
-            r.get::<Option<f64>, _>("target_sem_rel"),
-            r.get::<Option<i64>, _>("samples_max"),
-        ) {
-            (Some(t), Some(max)) => Some(TargetSem {
-                target_sem_rel: t,
-                min: samples.min(max as u32),
-                max: max as u32,
-            }),
-            _ => None,
-        };
-        CellPlan {
-            impacts,
-            samples,
-            until,
-            target,
-        }
-    }
-
-    /// Whether the samples of this cell may still be asked for more impacts, so the state
-    /// after their last impact must be kept.
-    pub fn impacts_may_grow(&self) -> bool {
-        self.until.is_some_and(|u| self.impacts < u.max)
-    }
-}
-
-const PLAN_COLUMNS: &str = "units, samples, units_max, units_step, samples_max, target_sem_rel";
+/// The columns of `cells` that [`stored_cell`] reads.
+pub(super) const CELL_COLUMNS: &str = "cell_index, angle_deg, shape, swept, params, units, samples,
+     units_max, units_step, samples_max, target_sem_rel";
 
 impl Store {
-    /// Every cell's current plan, in cell order.
-    pub(super) async fn cell_plans(&self, id: Uuid) -> Result<Vec<CellPlan>> {
-        Ok(sqlx::query(&format!(
-            "SELECT {PLAN_COLUMNS} FROM cells WHERE campaign_id = ? ORDER BY cell_index"
+    /// Every cell of campaign `id` as it stands now, in cell order.
+    pub(super) async fn stored_cells(&self, id: Uuid) -> Result<Vec<StoredCell>> {
+        sqlx::query(&format!(
+            "SELECT {CELL_COLUMNS} FROM cells WHERE campaign_id = ? ORDER BY cell_index"
         ))
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?
         .iter()
-        .map(CellPlan::from_row)
-        .collect())
+        .map(stored_cell)
+        .collect()
     }
 }
 
-/// After a job of `cell` completed: once every job of the cell is done, grows the cell by
-/// its rules or finishes it. Runs inside the completing transaction, so a crash anywhere
+/// What a farm reads of any stored spec: the campaign's seed, which every job's derives from.
+#[derive(Deserialize)]
+struct Seeded {
+    seed: u64,
+}
+
+/// After a job of cell `plan`, one with growth rules, completed: once every job of the cell
+/// is done, grows the cell as its scene decides or finishes it. Runs inside the completing transaction, so a crash anywhere
 /// leaves either the job still leased or the cell fully grown.
 pub(super) async fn settle_cell(
     tx: &mut Transaction<'static, Sqlite>,
+    scene: &dyn FarmScene,
     campaign: &str,
-    cell: i64,
-    plan: CellPlan,
+    plan: &StoredCell,
     now: i64,
 ) -> Result<()> {
-    if plan.until.is_none() && plan.target.is_none() {
-        return Ok(());
-    }
+    let cell = plan.index as i64;
     let open: i64 = sqlx::query(
         "SELECT COUNT(*) FROM jobs WHERE campaign_id = ? AND cell_index = ? AND state != 'done'",
     )
@@ -110,8 +104,10 @@ pub(super) async fn settle_cell(
     if open > 0 {
         return Ok(());
     }
+    // A unit stored before its masses had columns is read from its record.
     let rows = sqlx::query(
-        "SELECT j.sample_index, u.record
+        "SELECT j.sample_index, u.grain_kg_m, u.loss_kg_m,
+                CASE WHEN u.grain_kg_m IS NULL OR u.loss_kg_m IS NULL THEN u.record END
          FROM units u JOIN jobs j ON j.id = u.job_id
          WHERE j.campaign_id = ? AND j.cell_index = ? ORDER BY j.sample_index, u.unit",
     )
@@ -119,30 +115,23 @@ pub(super) async fn settle_cell(
     .bind(cell)
     .fetch_all(&mut **tx)
     .await?;
-    let mut samples: BTreeMap<u32, Vec<Impact>> = BTreeMap::new();
+    let mut samples: BTreeMap<u32, Vec<UnitMasses>> = BTreeMap::new();
     for r in &rows {
-        // An impact record's grain mass and loss are all the assessment reads of it.
-        let impact = serde_json::from_str(r.get::<&str, _>(1))
-            .map_err(|e| Error::Internal(format!("stored unit record: {e}")))?;
+        let masses = match (r.get::<Option<f64>, _>(1), r.get::<Option<f64>, _>(2)) {
+            (Some(grain_kg_m), Some(loss_kg_m)) => UnitMasses {
+                grain_kg_m,
+                loss_kg_m,
+            },
+            _ => scene.masses(r.get::<&str, _>(3))?.ok_or_else(|| {
+                Error::Internal(format!("cell {cell} grows, but its scene reads no masses"))
+            })?,
+        };
         samples
             .entry(r.get::<i64, _>(0) as u32)
             .or_default()
-            .push(impact);
+            .push(masses);
     }
-    let input = CellInput {
-        angle_deg: 0.0,
-        shape: String::new(),
-        swept: BTreeMap::new(),
-        planned_samples: plan.samples as usize,
-        planned_impacts: plan.impacts as usize,
-        samples: samples
-            .into_iter()
-            .map(|(sample, impacts)| SampleInput { sample, impacts })
-            .collect(),
-    };
-    let result = aggregate_cell(&input, SLOPE_WINDOW)
-        .map_err(|e| Error::Internal(format!("assessing cell {cell}: {e}")))?;
-    let step = next_step(&result, plan.until, plan.target);
+    let step = scene.next_step(plan, &samples)?;
     match step {
         NextStep::ExtendImpacts(to) => {
             sqlx::query(
@@ -161,7 +150,7 @@ pub(super) async fn settle_cell(
                 campaign,
                 cell,
                 PlanColumn::Impacts(to),
-                (to - plan.impacts) as i64 * plan.samples as i64,
+                (to - plan.units) as i64 * plan.samples as i64,
             )
             .await?;
         }
@@ -171,9 +160,11 @@ pub(super) async fn settle_cell(
                 .fetch_one(&mut **tx)
                 .await?;
             let seq: i64 = r.get(0);
-            let seed = CampaignSpec::from_json(&r.get::<String, _>(1))?.seed;
+            let seed = serde_json::from_str::<Seeded>(r.get::<&str, _>(1))
+                .map_err(|e| Error::Internal(format!("stored spec's seed: {e}")))?
+                .seed;
             let jobs: Vec<NewJob> = (plan.samples..to)
-                .map(|s| (cell as u32, s, plan.impacts, job_seed(seed, cell as u32, s)))
+                .map(|s| (plan.index, s, plan.units, job_seed(seed, plan.index, s)))
                 .collect();
             insert_queued_jobs(tx, campaign, seq, &jobs, now).await?;
             grow_cell(
@@ -181,7 +172,7 @@ pub(super) async fn settle_cell(
                 campaign,
                 cell,
                 PlanColumn::Samples(to),
-                (to - plan.samples) as i64 * plan.impacts as i64,
+                (to - plan.samples) as i64 * plan.units as i64,
             )
             .await?;
         }
@@ -190,7 +181,7 @@ pub(super) async fn settle_cell(
     let drop_checkpoints = match step {
         NextStep::ExtendImpacts(_) => false,
         // Added samples may leave the cell unsteady again, and then every sample grows.
-        NextStep::AddSamples(_) => !plan.impacts_may_grow(),
+        NextStep::AddSamples(_) => !plan.units_may_grow(),
         NextStep::Final => true,
     };
     if drop_checkpoints {

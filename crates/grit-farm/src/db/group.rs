@@ -26,6 +26,7 @@ use super::worker::{
 use crate::api::HeartbeatResponse;
 use crate::checkpoint::CheckpointBytes;
 use crate::error::{Error, Result};
+use crate::scenes::SceneRegistry;
 
 /// Most requests applied in one transaction; more wait for the next one. Bounds how long
 /// the writer holds the database between commits (and so the latency of other writes).
@@ -51,6 +52,8 @@ pub(super) enum Op {
         lease: Uuid,
         units: NewUnits,
         checkpoint: Option<CheckpointBytes>,
+        /// The scenes that judge the job's cell once it is done.
+        scenes: SceneRegistry,
     },
     Fail {
         job_id: i64,
@@ -232,8 +235,9 @@ async fn apply(
             lease,
             units,
             checkpoint,
+            scenes,
         } => {
-            apply_complete(tx, *job_id, *lease, units, checkpoint.as_ref()).await?;
+            apply_complete(tx, *job_id, *lease, units, checkpoint.as_ref(), scenes).await?;
             Reply::Done
         }
         Op::Fail {

@@ -10,6 +10,7 @@ use std::path::Path;
 use std::str::FromStr;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
+use grit_erosion::campaign::{CellRecords, StoredCell};
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
 };
@@ -22,7 +23,6 @@ mod campaigns;
 mod checkpoints;
 mod extend;
 mod group;
-mod jet;
 mod worker;
 mod workers;
 
@@ -42,6 +42,16 @@ fn impact_params(job: &crate::api::ClaimedJob) -> grit_erosion::ImpactParams {
     serde_json::from_value(job.params.clone()).expect("an impact claim's params")
 }
 
+/// The results of impact campaign `id`, for the tests.
+#[cfg(test)]
+async fn impact_results(s: &Store, id: Uuid) -> grit_erosion::CampaignResults {
+    let r = s.results_any(id, false).await.expect("results");
+    r.impact()
+        .expect("an impact campaign's results")
+        .results
+        .clone()
+}
+
 /// A report of jet slices, for the tests.
 #[cfg(test)]
 fn jet(records: &[grit_erosion::jet::JetSlice]) -> Reported {
@@ -54,6 +64,8 @@ mod extend_tests;
 mod group_tests;
 #[cfg(test)]
 mod jet_tests;
+#[cfg(test)]
+mod results_tests;
 #[cfg(test)]
 mod tests;
 
@@ -183,13 +195,12 @@ async fn release_writer(conn: &mut sqlx::SqliteConnection) -> sqlx::Result<bool>
 }
 
 impl Store {
-    /// Campaign `id`'s stored unit records parsed as `T`, grouped per cell (`cells` of them)
-    /// and per sample, in unit order; records of cells beyond `cells` are left out.
-    async fn cell_records<T: serde::de::DeserializeOwned>(
+    /// `cells` of campaign `id` with the records (JSON) their samples stored, in unit order.
+    async fn cell_records(
         &self,
         id: Uuid,
-        cells: usize,
-    ) -> Result<Vec<std::collections::BTreeMap<u32, Vec<T>>>> {
+        cells: Vec<StoredCell>,
+    ) -> Result<Vec<CellRecords<String>>> {
         let rows = sqlx::query(
             "SELECT j.cell_index, j.sample_index, u.record
              FROM units u JOIN jobs j ON j.id = u.job_id
@@ -199,15 +210,18 @@ impl Store {
         .bind(id.to_string())
         .fetch_all(&self.read)
         .await?;
-        let mut per_cell: Vec<std::collections::BTreeMap<u32, Vec<T>>> =
-            (0..cells).map(|_| Default::default()).collect();
-        for r in &rows {
+        let mut per_cell: Vec<CellRecords<String>> = cells
+            .into_iter()
+            .map(|cell| CellRecords {
+                cell,
+                samples: Default::default(),
+            })
+            .collect();
+        for r in rows {
             let cell = r.get::<i64, _>(0) as usize;
-            let sample = r.get::<i64, _>(1) as u32;
-            if let Some(m) = per_cell.get_mut(cell) {
-                let rec = serde_json::from_str(r.get::<&str, _>(2))
-                    .map_err(|e| Error::Internal(format!("stored unit record: {e}")))?;
-                m.entry(sample).or_default().push(rec);
+            if let Some(c) = per_cell.get_mut(cell) {
+                let sample = r.get::<i64, _>(1) as u32;
+                c.samples.entry(sample).or_default().push(r.get(2));
             }
         }
         Ok(per_cell)

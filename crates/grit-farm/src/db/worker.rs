@@ -15,21 +15,23 @@ use grit_erosion::Scene;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
-use super::extend::CellPlan;
+use super::extend::stored_cell;
 use super::group::{mismatch, Op, Reply};
 use super::{now_ms, parse_uuid, Store};
 use crate::api::{Checkpoint, ClaimedJob, HeartbeatResponse};
 use crate::checkpoint::{sha256_hex, CheckpointBytes};
 use crate::error::{Error, Result};
+use crate::scenes::SceneRegistry;
+use grit_erosion::campaign::{StoredCell, UnitMasses};
 
 /// Longest failure message kept per job.
 pub(super) const MAX_ERROR_CHARS: usize = 4000;
 /// Workers silent for longer are forgotten, so the table of names cannot grow without end.
 const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 
-/// Unit rows inserted by one statement: 5 bound values each keeps it under SQLite's smallest
+/// Unit rows inserted by one statement: 7 bound values each keeps it under SQLite's smallest
 /// limit on bound variables (999).
-const UNIT_ROWS_PER_INSERT: usize = 150;
+const UNIT_ROWS_PER_INSERT: usize = 140;
 
 /// A checkpoint as stored.
 struct StoredCheckpoint {
@@ -107,6 +109,8 @@ pub(super) struct NewUnits {
     /// Each record's unit number (1-based) and the record as JSON, with round-trip float
     /// formatting (every f64 comes back bit for bit).
     rows: Vec<(u32, String)>,
+    /// What a cell's growth reads of each record ([`Scene::masses`]), stored beside it.
+    masses: Vec<Option<UnitMasses>>,
     /// The scene's checks of the records.
     check: Box<dyn CheckUnits>,
 }
@@ -127,6 +131,7 @@ impl Reported {
             kind: "",
             unit: "unit",
             rows: Vec::new(),
+            masses: Vec::new(),
             check: Box::new(NoUnits),
         })
     }
@@ -156,6 +161,7 @@ impl NewUnits {
             kind: S::KIND,
             unit: S::UNIT,
             rows,
+            masses: records.iter().map(S::masses).collect(),
             check: Box::new(Records::<S>(records.to_vec())),
         })
     }
@@ -276,6 +282,7 @@ impl Store {
             lease,
             units: reported.0,
             checkpoint,
+            scenes: self.scenes.clone(),
         };
         self.group.apply(op).await.map(drop)
     }
@@ -429,6 +436,7 @@ pub(super) async fn apply_complete(
     lease: Uuid,
     units: &NewUnits,
     checkpoint: Option<&CheckpointBytes>,
+    scenes: &SceneRegistry,
 ) -> Result<()> {
     let Report { now, held, done } = report(tx, job_id, lease, units, checkpoint).await?;
     if done < held.planned {
@@ -442,13 +450,17 @@ pub(super) async fn apply_complete(
     }
     end_lease(tx, job_id, "done", done, now).await?;
     // A job that never stored a checkpoint has none to drop.
-    if !held.plan.impacts_may_grow() && (held.has_checkpoint || checkpoint.is_some()) {
+    if !held.cell.units_may_grow() && (held.has_checkpoint || checkpoint.is_some()) {
         sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
             .bind(job_id)
             .execute(&mut **tx)
             .await?;
     }
-    super::extend::settle_cell(tx, &held.campaign, held.cell, held.plan, now).await
+    if held.cell.until_steady.is_none() && held.cell.target_sem.is_none() {
+        return Ok(());
+    }
+    let scene = scenes.get(&held.scene)?;
+    super::extend::settle_cell(tx, &*scene, &held.campaign, &held.cell, now).await
 }
 
 /// A failure in `tx`, by the rules of [`Store::fail`]; `error` comes cut to
@@ -518,14 +530,13 @@ struct Held {
     /// The lease holder's name.
     worker: Option<String>,
     campaign: String,
-    cell: i64,
-    plan: CellPlan,
+    /// The job's cell as it stands now; its `params`, the scene as JSON, bound the records a
+    /// worker may send.
+    cell: StoredCell,
     /// Whether a checkpoint of the job is stored.
     has_checkpoint: bool,
     /// The job's scene (`campaigns.scene`).
     scene: String,
-    /// `cells.params`: the scene as JSON, which bounds the records a worker may send.
-    params: String,
 }
 
 async fn check_lease(
@@ -538,6 +549,7 @@ async fn check_lease(
         "SELECT j.state AS state, j.lease_id AS lease_id, j.lease_expires_ms AS lease_expires_ms,
                 j.units_planned AS units_planned, j.units_done AS units_done,
                 j.worker AS worker, j.campaign_id AS campaign_id, j.cell_index AS cell_index,
+                k.angle_deg AS angle_deg, k.shape AS shape, k.swept AS swept,
                 k.units AS units, k.samples AS samples, k.units_max AS units_max,
                 k.units_step AS units_step, k.samples_max AS samples_max,
                 k.target_sem_rel AS target_sem_rel,
@@ -573,11 +585,9 @@ async fn check_lease(
         done: r.get::<i64, _>("units_done") as u32,
         worker: r.get("worker"),
         campaign: r.get("campaign_id"),
-        cell: r.get("cell_index"),
-        plan: CellPlan::from_row(&r),
+        cell: stored_cell(&r)?,
         has_checkpoint: r.get("has_checkpoint"),
         scene: r.get("scene"),
-        params: r.get("params"),
     })
 }
 
@@ -701,9 +711,12 @@ async fn store_units(
     if new.is_empty() {
         return Ok(done);
     }
-    let lost = units
-        .check
-        .check(job_id, &held.params, &new, stored_loss(tx, job_id).await?)?;
+    let lost = units.check.check(
+        job_id,
+        &held.cell.params,
+        &new,
+        stored_loss(tx, job_id).await?,
+    )?;
     for chunk in new
         .iter()
         .zip(&lost)
@@ -711,15 +724,18 @@ async fn store_units(
         .chunks(UNIT_ROWS_PER_INSERT)
     {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
-            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms) ",
+            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms, grain_kg_m, loss_kg_m) ",
         );
         qb.push_values(chunk, |mut b, (&i, &lost)| {
             let (n, json) = &units.rows[i];
+            let masses = units.masses[i];
             b.push_bind(job_id)
                 .push_bind(*n as i64)
                 .push_bind(lost)
                 .push_bind(json.as_str())
-                .push_bind(now);
+                .push_bind(now)
+                .push_bind(masses.map(|m| m.grain_kg_m))
+                .push_bind(masses.map(|m| m.loss_kg_m));
         });
         qb.build().execute(&mut **tx).await?;
     }

@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 
 use axum::body::Bytes;
 use axum::extract::{Path, Query, State};
-use axum::http::{HeaderMap, StatusCode};
+use axum::http::{header, HeaderMap, StatusCode};
+use axum::response::IntoResponse;
 use axum::routing::{get, post};
 use axum::{Json, Router};
 use grit_erosion::campaign::AnySpec;
@@ -145,10 +146,11 @@ async fn campaign_results(
     State(s): State<AppState>,
     Path(id): Path<String>,
     Query(q): Query<BTreeMap<String, String>>,
-) -> Result<Json<AnyResults>> {
+) -> Result<impl IntoResponse> {
     let id = campaign_id(&id)?;
     let q = ResultsQuery::parse(&q)?;
-    Ok(Json(s.store.results_any(id, q.raw).await?))
+    let json = s.store.results_json(id, q.raw).await?;
+    Ok(([(header::CONTENT_TYPE, "application/json")], json))
 }
 
 /// Query of `GET /campaigns/{id}/jobs`.

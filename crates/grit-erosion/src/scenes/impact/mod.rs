@@ -8,6 +8,7 @@ mod run;
 pub mod sample;
 pub mod spec;
 pub mod steady;
+mod stored;
 
 pub use params::*;
 pub use run::*;

@@ -5,6 +5,9 @@ use grit_sph::{InputError, Particles, ParticlesState, Timers};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use std::collections::BTreeMap;
+
+use crate::campaign::{CellRecords, NextStep, StoredCell, StoredJob, UnitMasses};
 use crate::impact::aggregate::Impact;
 use crate::impact::{
     run_impact_observed, GrainStart, ImpactError, ImpactOutcome, ImpactParams, StepObserver,
@@ -316,6 +319,7 @@ impl Sample {
 impl Scene for Sample {
     const KIND: &'static str = "impact";
     const UNIT: &'static str = "impact";
+    const RECORDS: &'static str = "impacts";
     // A cancelled impact leaves the sample as it was after the last one.
     const CHECKPOINT_EACH_UNIT: bool = false;
     type Params = ImpactParams;
@@ -401,6 +405,25 @@ impl Scene for Sample {
             ));
         }
         Ok(after)
+    }
+
+    fn results(
+        spec: &str,
+        cells: Vec<CellRecords<ImpactRecord>>,
+        raw: Option<Vec<StoredJob<ImpactRecord>>>,
+    ) -> Result<String, SceneError> {
+        super::stored::results(spec, cells, raw)
+    }
+
+    fn masses(record: &ImpactRecord) -> Option<UnitMasses> {
+        Some(super::stored::masses(record))
+    }
+
+    fn next_step(
+        cell: &StoredCell,
+        samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep, SceneError> {
+        super::stored::grow(cell, samples)
     }
 }
 

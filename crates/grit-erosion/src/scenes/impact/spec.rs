@@ -16,11 +16,10 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize, Serializer};
 use serde_json::{Map, Value};
 
-use super::aggregate::{CellInput, SampleInput};
 use super::params::ImpactParams;
 use crate::campaign::json::{self, field_path, one_or_many, reject_unknown};
 use crate::campaign::{
-    cell_count, check_cells, check_list_len, check_sweep, err, job_count, job_seed, sweep_indices,
+    cell_count, check_cells, check_list_len, check_sweep, err, job_count, sweep_indices,
     ImpactPlan, MaterialSpec, Samples, SpecError, Sweep, UntilSteady, MAX_IMPACTS,
     MAX_IMPACTS_TOTAL, MAX_JOBS, MIN_IMPACTS,
 };
@@ -124,7 +123,7 @@ impl Default for GrainSpec {
 ///
 /// Deserialise it with `CampaignSpec::from_json`, which names every unknown field at once and
 /// the path of any value of the wrong type, or with plain serde, which stops at the first.
-/// Semantic rules (ranges, counts) are checked by `validate`, which `expand` runs first.
+/// Semantic rules (ranges, counts) are checked by `validate`, which `cells` runs first.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CampaignSpec {
@@ -204,21 +203,6 @@ pub struct Cell {
     /// Values of the swept dimensions other than angle and shape, by name with unit; a swept
     /// material appears as `material_index` (its position in the spec's `material` list).
     pub swept: BTreeMap<String, f64>,
-}
-
-/// One sample of one cell: the unit a worker leases.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct JobSpec {
-    /// Index of the cell.
-    pub cell: u32,
-    /// Index of the sample within the cell (0-based).
-    pub sample: u32,
-    /// Impacts planned.
-    pub impacts: u32,
-    /// Seed of the sample (module docs).
-    pub seed: u64,
-    /// The impact scene.
-    pub params: ImpactParams,
 }
 
 /// Maps a field of `ImpactParams` to where the spec sets it, so scene errors name spec fields.
@@ -479,45 +463,12 @@ impl CampaignSpec {
         self.validate()?;
         Ok(self.cells_unchecked())
     }
-
-    /// Every job, cell by cell and sample by sample, each with its own seed; validates first.
-    pub fn expand(&self) -> Result<Vec<JobSpec>, SpecError> {
-        let cells = self.cells()?;
-        let samples = self.samples.initial();
-        let mut jobs = Vec::with_capacity(cells.len() * samples as usize);
-        for cell in &cells {
-            for sample in 0..samples {
-                jobs.push(JobSpec {
-                    cell: cell.index,
-                    sample,
-                    impacts: cell.impacts,
-                    seed: job_seed(self.seed, cell.index, sample),
-                    params: cell.params.clone(),
-                });
-            }
-        }
-        Ok(jobs)
-    }
-}
-
-impl Cell {
-    /// The aggregation input of this cell, given the samples reported so far.
-    pub fn input(&self, planned_samples: u32, samples: Vec<SampleInput>) -> CellInput {
-        CellInput {
-            angle_deg: self.params.angle_deg,
-            shape: self.params.shape.name().to_string(),
-            swept: self.swept.clone(),
-            planned_samples: planned_samples as usize,
-            planned_impacts: self.impacts as usize,
-            samples,
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::campaign::{mix, MAX_LIST};
+    use crate::campaign::{job_seed, mix, AnySpec, MAX_LIST};
     use grit_sph::Material;
 
     fn parse(json: &str) -> Result<CampaignSpec, SpecError> {
@@ -564,10 +515,9 @@ mod tests {
             ImpactParams::paper(15.0, Shape::Octagon),
             "cells use the paper scene"
         );
-        let jobs = s.expand().unwrap();
-        assert_eq!(jobs.len(), 24 * 25);
         let total: u64 = (140 + 70 + 4 * 60) * 4 * 25;
         let plan = crate::campaign::AnySpec::Impact(s).plan().unwrap();
+        assert_eq!(plan.jobs.len(), 24 * 25);
         assert_eq!(plan.units_total, total);
     }
 
@@ -821,21 +771,22 @@ mod tests {
     fn expansion_is_deterministic_and_seeds_distinct() {
         let json =
             r#"{"seed": 42, "velocity_m_s": [80, 100], "grain": {"diameter_m": [2e-4, 2.5e-4]}}"#;
-        let a = parse(json).unwrap().expand().unwrap();
-        let b = parse(json).unwrap().expand().unwrap();
-        assert_eq!(a, b);
-        assert_eq!(a.len(), 6 * 4 * 2 * 2 * 25);
-        let mut seeds: Vec<u64> = a.iter().map(|j| j.seed).collect();
+        let plan = |json: &str| AnySpec::Impact(parse(json).unwrap()).plan().unwrap();
+        let a = plan(json);
+        assert_eq!(a, plan(json));
+        assert_eq!(a.jobs.len(), 6 * 4 * 2 * 2 * 25);
+        let mut seeds: Vec<u64> = a.jobs.iter().map(|j| j.3).collect();
         seeds.sort_unstable();
         seeds.dedup();
-        assert_eq!(seeds.len(), a.len(), "every job has its own seed");
-        let other = parse(r#"{"seed": 43}"#).unwrap().expand().unwrap();
-        assert_ne!(other[0].seed, a[0].seed);
+        assert_eq!(seeds.len(), a.jobs.len(), "every job has its own seed");
+        assert_ne!(plan(r#"{"seed": 43}"#).jobs[0].3, a.jobs[0].3);
         // Angle varies fastest, then shape, then the other sweeps.
-        assert_eq!(a[0].params.angle_deg, 15.0);
-        assert_eq!(a[25].params.angle_deg, 30.0);
-        assert_eq!(a[6 * 25].params.shape, Shape::Hexagon);
-        assert_eq!(a[24 * 25].params.velocity_m_s, 100.0);
+        let cells = parse(json).unwrap().cells().unwrap();
+        let job = |k: usize| &cells[a.jobs[k].0 as usize].params;
+        assert_eq!(job(0).angle_deg, 15.0);
+        assert_eq!(job(25).angle_deg, 30.0);
+        assert_eq!(job(6 * 25).shape, Shape::Hexagon);
+        assert_eq!(job(24 * 25).velocity_m_s, 100.0);
     }
 
     #[test]
@@ -848,16 +799,16 @@ mod tests {
     }
 
     #[test]
-    fn cell_input_carries_swept_values() {
+    fn a_planned_cell_carries_swept_values() {
         let s = parse(r#"{"angles_deg": [45], "shapes": ["hexagon"], "velocity_m_s": [80, 100]}"#)
             .unwrap();
-        let cells = s.cells().unwrap();
-        assert_eq!(cells.len(), 2);
-        let input = cells[1].input(s.samples.initial(), vec![]);
-        assert_eq!(input.angle_deg, 45.0);
-        assert_eq!(input.shape, "hexagon");
-        assert_eq!(input.swept.get("velocity_m_s"), Some(&100.0));
-        assert_eq!(input.planned_impacts, 60);
-        assert_eq!(input.planned_samples, 25);
+        let plan = AnySpec::Impact(s).plan().unwrap();
+        assert_eq!(plan.cells.len(), 2);
+        let cell = &plan.cells[1];
+        assert_eq!(cell.angle_deg, Some(45.0));
+        assert_eq!(cell.shape.as_deref(), Some("hexagon"));
+        assert_eq!(cell.swept.get("velocity_m_s"), Some(&100.0));
+        assert_eq!(cell.units, 60);
+        assert_eq!(plan.samples, 25);
     }
 }

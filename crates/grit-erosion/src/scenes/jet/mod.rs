@@ -14,6 +14,7 @@ mod run;
 pub mod runs;
 mod scene;
 pub mod spec;
+mod stored;
 
 pub use feed::{grain_spacing_m, Feed};
 pub use params::*;

@@ -10,6 +10,7 @@ use sha2::Digest;
 
 use super::feed::Feed;
 use super::scene::{self, Layout};
+use crate::campaign::{CellRecords, StoredJob};
 use crate::scene::{Scene, SceneError};
 use crate::stats::{stats, Stats};
 
@@ -478,6 +479,7 @@ impl JetRun {
 impl Scene for JetRun {
     const KIND: &'static str = "jet";
     const UNIT: &'static str = "slice";
+    const RECORDS: &'static str = "slices";
     // A cancelled slice leaves the world mid-slice.
     const CHECKPOINT_EACH_UNIT: bool = true;
     type Params = JetParams;
@@ -544,5 +546,13 @@ impl Scene for JetRun {
             ));
         }
         Ok(loss)
+    }
+
+    fn results(
+        spec: &str,
+        cells: Vec<CellRecords<JetSlice>>,
+        raw: Option<Vec<StoredJob<JetSlice>>>,
+    ) -> Result<String, SceneError> {
+        super::stored::results(spec, cells, raw)
     }
 }

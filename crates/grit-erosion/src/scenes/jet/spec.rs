@@ -19,7 +19,7 @@ use serde_json::{Map, Value};
 
 use crate::campaign::json::{self, count, field_path, reject_unknown};
 use crate::campaign::{
-    cell_count, check_cells, check_list_len, check_sweep, err, job_count, job_seed, sweep_indices,
+    cell_count, check_cells, check_list_len, check_sweep, err, job_count, sweep_indices,
     MaterialSpec, SpecError, Sweep, MAX_JOBS,
 };
 use crate::jet::JetParams;
@@ -69,7 +69,7 @@ pub const DEFAULT_JET_SAMPLES: u32 = 3;
 /// A jet campaign as submitted: `"scene": "jet"` and the sweeps of the module documentation.
 ///
 /// Parse with [`JetCampaignSpec::from_json`], which names every unknown field at once and the
-/// path of a value of the wrong type; `validate` checks the rules, `expand` runs it first.
+/// path of a value of the wrong type; `validate` checks the rules, `cells` runs it first.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct JetCampaignSpec {
@@ -171,21 +171,6 @@ pub struct JetCell {
     pub slices: u32,
     /// Values of the swept dimensions, by spec name (a swept material as `material_index`).
     pub swept: BTreeMap<String, f64>,
-}
-
-/// One sample of one jet cell: the unit a worker leases.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct JetJob {
-    /// Index of the cell.
-    pub cell: u32,
-    /// Index of the sample within the cell (0-based).
-    pub sample: u32,
-    /// Slices planned.
-    pub slices: u32,
-    /// Seed of the abrasive placement (`campaign::job_seed`).
-    pub seed: u64,
-    /// The run's parameters.
-    pub params: JetParams,
 }
 
 /// The swept dimensions in expansion order, fastest first: (spec field, number of values).
@@ -417,24 +402,6 @@ impl JetCampaignSpec {
         self.validate()?;
         Ok(self.cells_unchecked())
     }
-
-    /// Every job, cell by cell and sample by sample, each with its own seed; validates first.
-    pub fn expand(&self) -> Result<Vec<JetJob>, SpecError> {
-        let cells = self.cells()?;
-        let mut jobs = Vec::with_capacity(cells.len() * self.samples as usize);
-        for cell in &cells {
-            for sample in 0..self.samples {
-                jobs.push(JetJob {
-                    cell: cell.index,
-                    sample,
-                    slices: cell.slices,
-                    seed: job_seed(self.seed, cell.index, sample),
-                    params: cell.params.clone(),
-                });
-            }
-        }
-        Ok(jobs)
-    }
 }
 
 fn both_speeds() -> SpecError {
@@ -447,6 +414,7 @@ fn both_speeds() -> SpecError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::campaign::job_seed;
 
     /// A small, valid scene: the fields every test below shares.
     const SMALL: &str = r#""spacing_m": 1e-4, "jet_width_m": 6e-4, "target_width_m": 3e-3,
@@ -473,9 +441,10 @@ mod tests {
         assert_eq!(cells.len(), 1);
         assert_eq!(cells[0].params, JetParams::default());
         assert!(cells[0].swept.is_empty());
-        assert_eq!(s.expand().unwrap().len(), DEFAULT_JET_SAMPLES as usize);
+        let plan = crate::campaign::AnySpec::Jet(s).plan().unwrap();
+        assert_eq!(plan.jobs.len(), DEFAULT_JET_SAMPLES as usize);
         assert_eq!(
-            crate::campaign::AnySpec::Jet(s).plan().unwrap().units_total,
+            plan.units_total,
             JetParams::default().slices() as u64 * DEFAULT_JET_SAMPLES as u64
         );
     }
@@ -500,12 +469,13 @@ mod tests {
         assert_eq!(cells[10].swept["material_index"], 1.0);
         assert_eq!(cells[10].swept.len(), 3, "unswept fields are not listed");
         assert_eq!(cells[0].slices, 4);
-        let jobs = s.expand().unwrap();
+        let plan = || crate::campaign::AnySpec::Jet(s.clone()).plan().unwrap();
+        let jobs = plan().jobs;
         assert_eq!(jobs.len(), 24);
-        assert_eq!(jobs, s.expand().unwrap(), "deterministic");
-        assert_eq!((jobs[3].cell, jobs[3].sample), (1, 1));
-        assert_eq!(jobs[3].seed, job_seed(4, 1, 1));
-        let mut seeds: Vec<u64> = jobs.iter().map(|j| j.seed).collect();
+        assert_eq!(jobs, plan().jobs, "deterministic");
+        assert_eq!((jobs[3].0, jobs[3].1, jobs[3].2), (1, 1, 4));
+        assert_eq!(jobs[3].3, job_seed(4, 1, 1));
+        let mut seeds: Vec<u64> = jobs.iter().map(|j| j.3).collect();
         seeds.sort_unstable();
         seeds.dedup();
         assert_eq!(seeds.len(), jobs.len());
