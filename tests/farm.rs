@@ -699,11 +699,17 @@ async fn sigterm_releases_the_job_with_a_checkpoint_and_exits_0() {
     )
     .await;
     let pid = w.child.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
+    // Twice, as under Slurm, which signals every process of a job while the job's batch shell
+    // passes its own SIGTERM on: the second must not cut the checkpoint short. The child is
+    // not reaped yet, so the second finds its pid even if it has exited.
+    for _ in 0..2 {
+        assert!(Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success());
+        std::thread::sleep(Duration::from_millis(20));
+    }
     let start = Instant::now();
     let code = loop {
         if let Some(code) = w.child.try_wait().unwrap() {

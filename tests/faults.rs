@@ -7,7 +7,7 @@
 //! docs/operations.md describes what an operator sees and does in each case.
 //! Set TEST_LOG=1 to see the processes' logs.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -204,69 +204,66 @@ async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit()
     assert_matches_grit_run(&c, id, dir.path(), &spec, impacts).await;
 }
 
-/// A tmpfs mounted by the test, unmounted on drop.
-struct Mount(PathBuf);
-
-impl Mount {
-    /// Mounts a tmpfs of `size` (a `mount` size such as `16m`) at `dir`; the reason when
-    /// this machine does not allow it.
-    fn tmpfs(dir: &Path, size: &str) -> Result<Mount, String> {
-        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
-        let out = Command::new("mount")
-            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
-            .arg(dir)
-            .output()
-            .map_err(|e| format!("mount: {e}"))?;
-        if !out.status.success() {
-            return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
-        }
-        Ok(Mount(dir.to_path_buf()))
-    }
+/// The soft limit on the size of the files process `pid` writes (`RLIMIT_FSIZE`), set from
+/// outside while it runs; `None` restores `was`. Returns the limit it had. No privilege is
+/// needed to lower the soft limit of one's own process or to raise it back up to the hard one.
+fn set_file_size_limit(
+    pid: u32,
+    bytes: Option<libc::rlim_t>,
+    was: Option<libc::rlimit>,
+) -> libc::rlimit {
+    let pid = libc::pid_t::try_from(pid).unwrap();
+    let mut old = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: both pointers are to live rlimit values for the duration of the call.
+    let rc = unsafe { libc::prlimit(pid, libc::RLIMIT_FSIZE, std::ptr::null(), &mut old) };
+    assert_eq!(
+        rc,
+        0,
+        "prlimit reading RLIMIT_FSIZE of {pid}: {}",
+        std::io::Error::last_os_error()
+    );
+    let new = libc::rlimit {
+        rlim_cur: bytes.unwrap_or_else(|| was.expect("the limit to restore").rlim_cur),
+        rlim_max: old.rlim_max,
+    };
+    // SAFETY: as above.
+    let rc = unsafe { libc::prlimit(pid, libc::RLIMIT_FSIZE, &new, std::ptr::null_mut()) };
+    assert_eq!(
+        rc,
+        0,
+        "prlimit setting RLIMIT_FSIZE of {pid} to {bytes:?}: {}",
+        std::io::Error::last_os_error()
+    );
+    old
 }
 
-impl Drop for Mount {
-    fn drop(&mut self) {
-        let _ = Command::new("umount").arg("-l").arg(&self.0).status();
-    }
-}
-
-/// Writes zeros to `path` until the filesystem refuses; returns the bytes written.
-fn fill(path: &Path) -> u64 {
-    use std::io::Write;
-    let mut f = std::fs::File::create(path).unwrap();
-    let block = vec![0u8; 64 << 10];
-    let mut written = 0;
-    // Bounded: the filesystem is a few MB; stop at 1 GiB whatever happens.
-    while written < 1 << 30 {
-        match f.write(&block) {
-            Ok(0) | Err(_) => break,
-            Ok(n) => written += n as u64,
-        }
-    }
-    let _ = f.sync_all();
-    written
-}
-
-/// The coordinator's database on a small tmpfs that fills up: writes are refused with 503
-/// naming the cause, the workers retry, what was stored stays, and once space is freed the
-/// campaign completes bit for bit. Skips (passing) where the test may not mount a tmpfs.
+/// The coordinator's disk refusing every write (its file-size limit lowered to 0 while it
+/// runs, so each write fails with `EFBIG`, as a write over a disk quota fails with `EDQUOT`;
+/// SQLite reports both as `SQLITE_IOERR_WRITE`): writes are refused with 503 naming the
+/// cause, the workers retry, what was stored stays, and once writes succeed again the campaign
+/// completes bit for bit. `SQLITE_FULL` itself (no space left) is the unit test
+/// `a_full_database_is_503_and_recovers`. Needs no privilege, so it runs everywhere.
 #[tokio::test(flavor = "multi_thread")]
 async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    // 16 MB: a fresh write-ahead log stays under SQLite's 4 MB auto-checkpoint before the
-    // disk is filled, so every later write must grow it and finds no space.
-    let mnt = dir.path().join("small-disk");
-    let mount = match Mount::tmpfs(&mnt, "16m") {
-        Ok(m) => m,
-        Err(why) => {
-            eprintln!("skipping the full-disk test: cannot mount a tmpfs here ({why})");
-            return;
-        }
-    };
     let spec = campaign(1, 6);
-    let db = mount.0.join("farm.db");
-    let coord = start_coordinator(dir.path(), "a", "127.0.0.1:0", 30.0, &[], Some(&db));
+    let mut cmd = common::coordinator_command(dir.path(), "127.0.0.1:0", 30.0, &[], None);
+    // The process must see EFBIG rather than die of the SIGXFSZ that comes with it.
+    // SAFETY: only signal(2), async-signal-safe, runs between fork and exec.
+    unsafe {
+        use std::os::unix::process::CommandExt;
+        cmd.pre_exec(|| {
+            if libc::signal(libc::SIGXFSZ, libc::SIG_IGN) == libc::SIG_ERR {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let mut coord = common::start_coordinator_piped_log(dir.path(), "a", cmd);
     let c = submitter(&coord.url);
     let id = c.submit(&spec, None).await.unwrap().id;
     let mut w = worker(dir.path(), &coord.url, "w1", &[]);
@@ -274,14 +271,16 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
     wait_impacts(&c, id, 2, limit).await;
     let before = raw_series(&c.results_value(id, true).await.unwrap());
 
-    let filler = mount.0.join("filler");
-    let filled = fill(&filler);
-    assert!(filled > 0, "the filler got no space at all");
-    // The worker's next report (an impact and its checkpoint) needs space.
+    let pid = coord.proc.child.id();
+    let was = set_file_size_limit(pid, Some(0), None);
+    // The worker's next report (an impact and its checkpoint) must be written.
     let start = Instant::now();
-    while !(coord.proc.log_text().contains("database or disk is full")
-        && w.log_text().contains("503"))
-    {
+    while !(coord.proc.log_text().contains("refused the write") && w.log_text().contains("503")) {
+        assert!(
+            coord.proc.child.try_wait().unwrap().is_none(),
+            "the coordinator died:\n{}",
+            coord.proc.log_text()
+        );
         assert!(
             start.elapsed() < Duration::from_secs(90),
             "no refused write seen.\ncoordinator:\n{}\nworker:\n{}",
@@ -292,7 +291,7 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
     }
     let log = w.log_text();
     assert!(
-        log.contains("disk is full"),
+        log.contains("SQLITE_IOERR_WRITE") && log.contains("nothing was stored"),
         "the 503 names the cause:\n{log}"
     );
     assert_alive(&mut [&mut w]);
@@ -305,16 +304,19 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
             "stored impacts changed"
         );
     }
+    let stuck = c.status(id).await.unwrap();
+    assert!(stuck.impacts_done < 6, "writes went on: {stuck:?}");
 
-    std::fs::remove_file(&filler).unwrap();
+    set_file_size_limit(pid, None, Some(was));
     let s = wait_done(&c, id, Duration::from_secs(180)).await;
     assert_eq!(s.impacts_done, 6);
     assert_matches_grit_run(&c, id, dir.path(), &spec, 6).await;
-    if let Ok(out) = Command::new("sqlite3")
-        .arg(mount.0.join("farm.db"))
+    let out = Command::new("sqlite3")
+        .arg(dir.path().join("farm.db"))
         .arg("PRAGMA integrity_check;")
-        .output()
-    {
+        .output();
+    // sqlite3 is not needed for the rest of the suite; where it is installed it must agree.
+    if let Ok(out) = out {
         let text = String::from_utf8_lossy(&out.stdout);
         assert!(
             !out.status.success() || text.trim() == "ok",
@@ -322,10 +324,6 @@ async fn full_disk_refuses_writes_with_503_and_recovers_when_freed() {
         );
     }
     assert_alive(&mut [&mut w]);
-    // Both processes stop before the tmpfs is unmounted.
-    drop(w);
-    drop(coord);
-    drop(mount);
 }
 
 /// An envelope of `bytes` for job `job` that keeps `meant`'s length and checksum, as when

@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::Context;
 use grit_erosion::campaign::MaterialSpec;
 use grit_erosion::jet::{JetParams, JetRun, JetSlice};
+use grit_sph::cracks::RockDamage;
 use grit_sph::crater::CraterSample;
 use serde::Serialize;
 
@@ -78,8 +79,9 @@ pub struct JetArgs {
 struct JetOutput<'a> {
     params: &'a JetParams,
     seed: u64,
-    /// One point per slice: t, mass loss per metre, Cd, Cw, largest plastic strain.
-    series: Vec<CraterSample>,
+    /// One point per slice: t, mass loss per metre, Cd, Cw, largest plastic strain, and for a
+    /// rock its detached mass and cracks.
+    series: Vec<SeriesPoint>,
     /// The slices with their profiles and costs.
     slices: &'a [JetSlice],
     /// Wall-clock seconds of the run.
@@ -87,6 +89,16 @@ struct JetOutput<'a> {
     /// Why the run stopped early, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     error: Option<String>,
+}
+
+/// One point of the series: the crater sample, and on a rock target its damage
+/// (docs/jet.md#rock-targets) in the same object; a metal's points keep the sample's fields only.
+#[derive(Serialize)]
+struct SeriesPoint {
+    #[serde(flatten)]
+    sample: CraterSample,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    rock: Option<RockDamage>,
 }
 
 impl JetArgs {
@@ -203,7 +215,15 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
     let out = JetOutput {
         params: &params,
         seed,
-        series: run.slices().iter().map(|s| s.sample).collect(),
+        series: run
+            .slices()
+            .iter()
+            .enumerate()
+            .map(|(k, s)| SeriesPoint {
+                sample: s.sample,
+                rock: run.rock_damage().get(k).copied(),
+            })
+            .collect(),
         slices: run.slices(),
         wall_s: t0.elapsed().as_secs_f64(),
         error: failure.as_ref().map(|e| e.to_string()),
@@ -244,6 +264,30 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
                 hits,
                 v_n
             );
+        }
+        if !run.rock_damage().is_empty() {
+            say!(
+                "{:>9} {:>12} {:>10} {:>7} {:>11} {:>11} {:>11}",
+                "t (ms)",
+                "detached",
+                "fractured",
+                "cracks",
+                "length µm",
+                "below Cd µm",
+                "damage mm²"
+            );
+            for (s, r) in run.slices().iter().zip(run.rock_damage()) {
+                say!(
+                    "{:>9.4} {:>12.4e} {:>10} {:>7} {:>11.0} {:>11.0} {:>11.4}",
+                    s.sample.t_s * 1e3,
+                    r.detached_kg_m,
+                    r.fractured_particles,
+                    r.crack_count,
+                    r.crack_length_m * 1e6,
+                    r.crack_depth_below_crater_m * 1e6,
+                    r.damaged_area_m2 * 1e6
+                );
+            }
         }
         say!("{:.1} s wall", out.wall_s);
     }

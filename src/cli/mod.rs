@@ -105,7 +105,10 @@ pub fn init_tracing(default: &str) {
         .try_init();
 }
 
-/// SIGTERM or SIGINT triggers `stop`; a second signal exits at once.
+/// SIGTERM or SIGINT triggers `stop`; a second SIGINT exits at once. Further SIGTERMs are the
+/// same request again: a scheduler may send it twice (Slurm signals every process of a job,
+/// and the job's shell passes its own on), and one arriving after the first was handled would
+/// otherwise cut the checkpoint short. Schedulers that lose patience send SIGKILL.
 pub fn on_signals(stop: Stop) {
     tokio::spawn(async move {
         #[cfg(unix)]
@@ -118,10 +121,14 @@ pub fn on_signals(stop: Stop) {
                 return;
             };
             tokio::select! { _ = term.recv() => {}, _ = int.recv() => {} }
-            tracing::info!("stop requested; finishing up (signal again to exit at once)");
+            tracing::info!("stop requested; finishing up (SIGINT again to exit at once)");
             stop.trigger();
-            tokio::select! { _ = term.recv() => {}, _ = int.recv() => {} }
-            std::process::exit(130);
+            loop {
+                tokio::select! {
+                    _ = term.recv() => tracing::info!("SIGTERM again; still finishing up"),
+                    _ = int.recv() => std::process::exit(130),
+                }
+            }
         }
         #[cfg(not(unix))]
         {

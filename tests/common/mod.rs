@@ -84,10 +84,46 @@ pub fn start_coordinator(
     extra: &[&str],
     db: Option<&Path>,
 ) -> Coordinator {
-    let db = db.map_or_else(|| dir.join("farm.db"), Path::to_path_buf);
+    let mut cmd = coordinator_command(dir, listen, lease_ttl_s, extra, db);
     let log = dir.join(format!("coordinator-{tag}.log"));
-    let mut child = Command::new(GRIT)
-        .args(["serve", "--db"])
+    cmd.stderr(std::fs::File::create(&log).unwrap());
+    spawn_coordinator(cmd, log)
+}
+
+/// `cmd` (from `coordinator_command`) started as `start_coordinator` does, with standard error sent through a pipe that the test copies into
+/// the log: a limit later set on the process's file writes (`RLIMIT_FSIZE`) then spares its
+/// log, where the test reads what it said about the refused writes.
+pub fn start_coordinator_piped_log(dir: &Path, tag: &str, mut cmd: Command) -> Coordinator {
+    let log = dir.join(format!("coordinator-{tag}.log"));
+    cmd.stderr(Stdio::piped());
+    let mut c = spawn_coordinator(cmd, log.clone());
+    let mut from = c.proc.child.stderr.take().unwrap();
+    let mut to = std::fs::File::create(&log).unwrap();
+    // Ends when the process does (its end of the pipe closes).
+    std::thread::spawn(move || {
+        use std::io::{Read, Write};
+        let mut buf = [0u8; 8192];
+        while let Ok(n @ 1..) = from.read(&mut buf) {
+            if to.write_all(&buf[..n]).is_err() {
+                break;
+            }
+        }
+    });
+    c.proc.log = log;
+    c
+}
+
+/// The `grit serve` command `start_coordinator` runs, before its standard error is set.
+pub fn coordinator_command(
+    dir: &Path,
+    listen: &str,
+    lease_ttl_s: f64,
+    extra: &[&str],
+    db: Option<&Path>,
+) -> Command {
+    let db = db.map_or_else(|| dir.join("farm.db"), Path::to_path_buf);
+    let mut cmd = Command::new(GRIT);
+    cmd.args(["serve", "--db"])
         .arg(&db)
         .args([
             "--listen",
@@ -98,9 +134,14 @@ pub fn start_coordinator(
         .args(extra)
         .env("GRIT_SUBMIT_TOKEN", SUBMIT)
         .env("GRIT_WORKER_TOKEN", WORKER)
-        .env("RUST_LOG", "info")
+        .env("RUST_LOG", "info");
+    cmd
+}
+
+/// Starts `cmd` (a `grit serve`) and reads the address it printed on its first line.
+fn spawn_coordinator(mut cmd: Command, log: PathBuf) -> Coordinator {
+    let mut child = cmd
         .stdout(Stdio::piped())
-        .stderr(std::fs::File::create(&log).unwrap())
         .spawn()
         .expect("grit serve starts");
     let mut line = String::new();

@@ -5,7 +5,9 @@
 
 use grit_sph::InputError;
 
-use crate::campaign::{CellRecords, NextStep, StoredJob};
+use std::collections::BTreeMap;
+
+use crate::campaign::{CellRecords, NextStep, StoredCell, StoredJob, UnitMasses};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 use serde::de::DeserializeOwned;
@@ -68,10 +70,21 @@ pub trait Scene: Sized + Send + Sync + 'static {
         raw: Option<Vec<StoredJob<Self::Record>>>,
     ) -> Result<String, SceneError>;
 
-    /// What a farm does with a cell once every sample has its planned units, from the cell's
-    /// records and growth rules (`docs/erosion.md`, "Extending a cell"). A scene without such
-    /// rules leaves every cell as planned.
-    fn next_step(_cell: &CellRecords<Self::Record>) -> Result<NextStep, SceneError> {
+    /// What a cell's growth ([`Scene::next_step`]) reads of a record, which a farm stores
+    /// beside it so that judging a cell need not parse every record; `None` for a scene whose
+    /// cells do not grow.
+    fn masses(_record: &Self::Record) -> Option<UnitMasses> {
+        None
+    }
+
+    /// What a farm does with `cell` once every sample has its planned units, from its growth
+    /// rules and its samples' units ([`Scene::masses`], in unit order, by sample)
+    /// (`docs/erosion.md`, "Extending a cell"). A scene without such rules leaves every cell
+    /// as planned.
+    fn next_step(
+        _cell: &StoredCell,
+        _samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep, SceneError> {
         Ok(NextStep::Final)
     }
 }

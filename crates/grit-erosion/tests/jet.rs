@@ -223,20 +223,37 @@ fn a_run_extends_to_its_own_end_or_later_but_not_into_its_slices() {
     assert!(e.contains("ended short"), "{e}");
 }
 
-// A JH-2 rock under the jet (docs/jet.md#rock-targets): `--material sandstone` runs, loses
-// mass, and a run resumed from its checkpoint (which keeps the bulking pressures beside the
-// particles) gives the bits of an unbroken one on one or two threads.
+// A JH-2 rock under the jet (docs/jet.md#rock-targets): `--material sandstone` runs, keeps its
+// fractured particles, loses mass (what no longer holds to the rock) and reports cracks, and a
+// run resumed from its checkpoint (which keeps the bulking pressures beside the particles and
+// the damage records beside the slices) gives the bits of an unbroken one on one or two threads.
 
 #[test]
-fn sandstone_loses_mass_and_resumes_bit_for_bit() {
+fn sandstone_keeps_fractured_rock_loses_mass_and_resumes_bit_for_bit() {
     let (whole, resumed) = whole_and_resumed(&tiny_rock(), 3);
-    let last = &whole.slices()[whole.slices().len() - 1];
+    let n = whole.slices().len();
+    let last = &whole.slices()[n - 1];
+    let rock = whole.rock_damage();
+    assert_eq!(rock.len(), n, "one damage record per slice");
     assert!(
         last.sample.mass_loss_kg_m > 0.0,
         "the rock lost no mass: {:?}",
         last.sample
     );
+    // Nothing of the rock is deleted: what is fractured stays, held or detached.
     let p = whole.world().particles();
+    let target = whole.layout().target_body as u32;
+    let fractured = (0..p.len())
+        .filter(|&i| p.body[i] == target && p.damage[i] >= 1.0)
+        .count();
+    assert!(fractured > 0, "nothing fractured");
+    assert_eq!(fractured, rock[n - 1].fractured_particles);
+    assert_eq!(whole.world().bodies()[target as usize].removed_particles, 0);
+    assert!(rock[n - 1].crack_count > 0, "no crack: {:?}", rock[n - 1]);
+    assert!(rock[n - 1].crack_length_m > 0.0);
+    // The loss is the detached mass and what left the scene, never more than the target.
+    assert!(last.sample.mass_loss_kg_m >= rock[n - 1].detached_kg_m);
+    assert!(last.sample.mass_loss_kg_m < tiny_rock().target_mass_kg_m());
     assert!(p.bulking.iter().any(|&b| b > 0.0), "no particle bulked");
     let state = |run: &JetRun| {
         let mut slices = run.slices().to_vec();
@@ -248,9 +265,19 @@ fn sandstone_loses_mass_and_resumes_bit_for_bit() {
             .iter()
             .map(|b| b.to_bits())
             .collect();
-        serde_json::to_string(&(run.world(), slices, bulking)).unwrap()
+        let rock: Vec<String> = run.rock_damage().iter().map(|r| format!("{r:?}")).collect();
+        serde_json::to_string(&(run.world(), slices, bulking, rock)).unwrap()
     };
     assert!(state(&whole) == state(&resumed), "the resumed run differs");
+}
+
+#[test]
+fn a_metal_run_keeps_no_rock_records() {
+    let mut run = JetRun::new(tiny(), 5).unwrap();
+    run.run_next_slice().unwrap();
+    assert!(run.rock_damage().is_empty());
+    let json = String::from_utf8(run.checkpoint()).unwrap();
+    assert!(!json.contains("\"rock\""), "a metal checkpoint names rock");
 }
 
 #[test]

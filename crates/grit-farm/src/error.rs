@@ -37,7 +37,7 @@ pub enum Error {
     /// The job was cancelled; its worker should drop it (410).
     #[error("{0}")]
     Gone(String),
-    /// Database failure (500, or 503 when its disk is full; details logged, not sent).
+    /// Database failure (500, or 503 when its disk refused the write; details logged, not sent).
     #[error(transparent)]
     Db(#[from] sqlx::Error),
     /// Migration failure at start-up.
@@ -50,6 +50,19 @@ pub enum Error {
 
 /// SQLite's result code for a write that found no space left.
 const SQLITE_FULL: i32 = 13;
+/// SQLite's extended result code for a write the filesystem refused for any other reason than
+/// `ENOSPC`: over a disk quota (`EDQUOT`, the usual "full disk" of a shared cluster), over the
+/// process's file-size limit (`EFBIG`), or an I/O error.
+const SQLITE_IOERR_WRITE: i32 = 778;
+
+/// Why the database refused a write that succeeds unchanged once the disk takes writes again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WriteRefused {
+    /// `SQLITE_FULL`: no space left on the filesystem.
+    Full,
+    /// `SQLITE_IOERR_WRITE`: a quota, a file-size limit or a disk error.
+    IoErrWrite,
+}
 
 /// Result with the coordinator's error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
@@ -63,24 +76,35 @@ impl Error {
         }
     }
 
-    /// Whether SQLite refused a write because the database's filesystem is full
-    /// (`SQLITE_FULL`, "database or disk is full"): nothing was written, and the same request
-    /// succeeds once space is freed, so it is answered 503 rather than 500.
-    pub fn is_disk_full(&self) -> bool {
-        match self {
-            Error::Db(sqlx::Error::Database(e)) => e
-                .code()
-                .and_then(|c| c.parse::<i32>().ok())
-                // The primary result code is the low byte of an extended one.
-                .is_some_and(|c| c & 0xff == SQLITE_FULL),
-            _ => false,
+    /// Whether SQLite refused a write because the database's filesystem would not take it
+    /// (full, over a quota or a file-size limit), and how: nothing was written, and the same
+    /// request succeeds once the disk takes writes again, so it is answered 503 rather than
+    /// 500 and workers retry it.
+    pub fn write_refused(&self) -> Option<WriteRefused> {
+        let Error::Db(sqlx::Error::Database(e)) = self else {
+            return None;
+        };
+        let code = e.code().and_then(|c| c.parse::<i32>().ok())?;
+        if code == SQLITE_IOERR_WRITE {
+            Some(WriteRefused::IoErrWrite)
+        } else if code & 0xff == SQLITE_FULL {
+            // The primary result code is the low byte of an extended one.
+            Some(WriteRefused::Full)
+        } else {
+            None
         }
+    }
+
+    /// Whether SQLite refused a write because the database's filesystem is full
+    /// (`SQLITE_FULL`, "database or disk is full").
+    pub fn is_disk_full(&self) -> bool {
+        self.write_refused() == Some(WriteRefused::Full)
     }
 
     /// The HTTP status this error is answered with.
     pub fn status(&self) -> StatusCode {
         match self {
-            e if e.is_disk_full() => StatusCode::SERVICE_UNAVAILABLE,
+            e if e.write_refused().is_some() => StatusCode::SERVICE_UNAVAILABLE,
             Error::Invalid { .. } => StatusCode::UNPROCESSABLE_ENTITY,
             Error::BadRequest { status, .. } => *status,
             Error::Unauthorized => StatusCode::UNAUTHORIZED,
@@ -111,6 +135,13 @@ impl IntoResponse for Error {
                 tracing::error!(error = %self, "the database's disk is full: free space on it; workers retry the refused writes");
                 ErrorBody {
                     error: "the coordinator's database disk is full (SQLITE_FULL); nothing was stored, retry once space is freed".into(),
+                    field: None,
+                }
+            }
+            e if e.write_refused().is_some() => {
+                tracing::error!(error = %self, "the database's disk refused the write: raise the quota or file-size limit, free space, or check the disk; workers retry the refused writes");
+                ErrorBody {
+                    error: "the coordinator's database disk refused the write (SQLITE_IOERR_WRITE: over a quota or file-size limit, or a disk error); nothing was stored, retry once it takes writes".into(),
                     field: None,
                 }
             }

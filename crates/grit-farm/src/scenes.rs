@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::marker::PhantomData;
 use std::sync::Arc;
 
-use grit_erosion::campaign::{CellRecords, NextStep, StoredJob};
+use grit_erosion::campaign::{CellRecords, NextStep, StoredCell, StoredJob, UnitMasses};
 use grit_erosion::{Scene, SceneSet, SceneVisitor};
 use serde_json::Value;
 
@@ -38,9 +38,14 @@ pub trait FarmScene: Send + Sync {
         cells: Vec<CellRecords<String>>,
         raw: Option<Vec<StoredJob<String>>>,
     ) -> Result<String>;
-    /// [`Scene::next_step`] of a cell whose samples have their planned units, its records as
-    /// stored (JSON).
-    fn next_step(&self, cell: CellRecords<String>) -> Result<NextStep>;
+    /// [`Scene::masses`] of a record as stored (JSON).
+    fn masses(&self, record: &str) -> Result<Option<UnitMasses>>;
+    /// [`Scene::next_step`] of a cell whose samples have their planned units.
+    fn next_step(
+        &self,
+        cell: &StoredCell,
+        samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep>;
 }
 
 /// A stored record (JSON) as scene `S`'s.
@@ -142,8 +147,16 @@ impl<S: Scene> FarmScene for Ops<S> {
         S::results(spec, cells, raw).map_err(scene_error)
     }
 
-    fn next_step(&self, cell: CellRecords<String>) -> Result<NextStep> {
-        S::next_step(&cell_records::<S>(cell)?).map_err(scene_error)
+    fn masses(&self, text: &str) -> Result<Option<UnitMasses>> {
+        Ok(S::masses(&record::<S>(text)?))
+    }
+
+    fn next_step(
+        &self,
+        cell: &StoredCell,
+        samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep> {
+        S::next_step(cell, samples).map_err(scene_error)
     }
 }
 

@@ -84,19 +84,65 @@ pub fn sample(
     surface_y_m: f64,
     opts: CraterOptions,
 ) -> Result<(CraterSample, Crater), InputError> {
-    let of_body: Vec<usize> = (0..particles.len())
-        .filter(|&i| particles.body[i] == body)
-        .collect();
+    let of_body = body_particles(particles, body);
     let pos: Vec<Vector> = of_body.iter().map(|&i| particles.pos[i]).collect();
-    let fixed: Vec<bool> = of_body
-        .iter()
-        .map(|&i| particles.flags.get(i).is_some_and(|f| f & KINEMATIC != 0))
-        .collect();
+    let fixed = fixed_of(particles, &of_body);
     let keep = if fixed.iter().any(|&f| f) {
         attached(&pos, &fixed, opts.link_m)?
     } else {
         vec![true; pos.len()]
     };
+    sample_kept(
+        t_s,
+        particles,
+        body,
+        mass_loss_kg_m,
+        surface_y_m,
+        opts,
+        &keep,
+    )
+}
+
+/// The indices of body `body`'s particles, in particle order: the order of the masks that
+/// [`sample_kept`] reads.
+pub fn body_particles(particles: &Particles, body: u32) -> Vec<usize> {
+    (0..particles.len())
+        .filter(|&i| particles.body[i] == body)
+        .collect()
+}
+
+/// Which of the particles `of_body` are fixed (kinematic).
+pub fn fixed_of(particles: &Particles, of_body: &[usize]) -> Vec<bool> {
+    of_body
+        .iter()
+        .map(|&i| particles.flags.get(i).is_some_and(|f| f & KINEMATIC != 0))
+        .collect()
+}
+
+/// [`sample`] with the caller's choice of the particles that still belong to the target:
+/// `keep`, one entry per particle of [`body_particles`] (a rock keeps the ones
+/// `cracks::held` names).
+pub fn sample_kept(
+    t_s: f64,
+    particles: &Particles,
+    body: u32,
+    mass_loss_kg_m: f64,
+    surface_y_m: f64,
+    opts: CraterOptions,
+    keep: &[bool],
+) -> Result<(CraterSample, Crater), InputError> {
+    let of_body = body_particles(particles, body);
+    if keep.len() != of_body.len() {
+        return Err(InputError::new(
+            "crater.keep",
+            format!(
+                "has {} entries for {} particles of body {body}",
+                keep.len(),
+                of_body.len()
+            ),
+        ));
+    }
+    let pos: Vec<Vector> = of_body.iter().map(|&i| particles.pos[i]).collect();
     let mut kept = Vec::with_capacity(pos.len());
     let mut max_eps = 0.0f64;
     for (k, &i) in of_body.iter().enumerate() {

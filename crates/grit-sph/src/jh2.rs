@@ -304,8 +304,10 @@ pub fn equivalent_rate(d: &Matrix) -> f64 {
 /// 1. the pressure from the polynomial EOS with the state's bulking, never below −T (1 − D);
 /// 2. the yield stress of eq. 38 at the state's damage; a trial above it is returned radially,
 ///    Δε_p = (σ_eq − σ_y)/(3G);
-/// 3. D += Δε_p / ε_f (eq. 39), at most 1; a fractured particle (D = 1) keeps no deviator and
-///    no longer gains plastic strain (the AWJ paper, after eq. 39);
+/// 3. D += Δε_p / ε_f (eq. 39), at most 1; a fractured particle (D = 1) no longer gains plastic
+///    strain (the AWJ paper, after eq. 39) and keeps a deviator up to the fractured strength
+///    σ_HEL σ*_f (eq. 38 at D = 1), none at P ≤ 0 (docs/jet.md#rock-targets: the paper's text
+///    zeroes it, its eq. 38 does not);
 /// 4. the elastic shear energy released as D grows, ΔU = (σ_y(D)² − σ_y(D')²)/(6G) at the step's
 ///    pressure, feeds the bulking pressure of eq. 41.
 ///
@@ -325,13 +327,20 @@ pub fn jh2_update(
     } = laws;
     let pressure = pressure_of(laws, rho, st.bulking, st.damage);
     if st.damage >= 1.0 {
+        // Comminuted rock: frictional strength under compression, none in tension.
+        let sf = strength.sigma_hel() * strength.fractured(pressure, rate);
+        let seq = von_mises(&s_trial);
+        let sdev = if seq <= sf {
+            s_trial
+        } else if sf > 0.0 {
+            s_trial * (sf / seq)
+        } else {
+            Matrix::zeros()
+        };
         return Jh2Step {
-            state: Jh2State {
-                sdev: Matrix::zeros(),
-                ..st
-            },
+            state: Jh2State { sdev, ..st },
             d_eps: 0.0,
-            sigma_y: 0.0,
+            sigma_y: seq.min(sf),
             released: 0.0,
         };
     }
@@ -359,8 +368,9 @@ pub fn jh2_update(
     let released = ((sy * sy - sy_new * sy_new) / (6.0 * shear)).max(0.0);
     let mu = rho / eos.rho0_kg_m3 - 1.0;
     let bulking = eos.bulked(st.bulking, mu, released);
+    // A particle fractured in this step drops at once to the fractured strength.
     let sdev = if damage >= 1.0 {
-        Matrix::zeros()
+        s_trial * (strength.sigma_hel() * strength.fractured(pressure, rate) / seq)
     } else {
         s_trial * (sy / seq)
     };
@@ -462,5 +472,27 @@ mod tests {
         );
         assert_eq!(r.state.sdev, Matrix::zeros());
         assert_eq!(r.d_eps, 0.0);
+    }
+
+    #[test]
+    fn a_fractured_particle_under_compression_keeps_the_fractured_strength() {
+        let l = Material::granite().jh2().unwrap();
+        let st = Jh2State {
+            sdev: Matrix::zeros(),
+            eps_p: 0.3,
+            damage: 1.0,
+            bulking: 0.0,
+        };
+        let rho = l.eos.rho0_kg_m3 * 1.02;
+        let p = pressure_of(&l, rho, 0.0, 1.0);
+        let sf = l.strength.sigma_hel() * l.strength.fractured(p, 1.0);
+        assert!(sf > 0.0);
+        let big = Matrix::new(2.0 * sf, 0.0, 0.0, -2.0 * sf);
+        let r = jh2_update(big, st, rho, 1.0, 2e10, &l);
+        assert!((von_mises(&r.state.sdev) / sf - 1.0).abs() < 1e-12);
+        assert_eq!((r.state.eps_p, r.state.damage, r.d_eps), (0.3, 1.0, 0.0));
+        let small = big * (0.1 * sf / von_mises(&big));
+        let r = jh2_update(small, st, rho, 1.0, 2e10, &l);
+        assert_eq!(r.state.sdev, small);
     }
 }

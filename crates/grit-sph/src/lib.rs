@@ -19,6 +19,7 @@ pub use material::{Fracture, JohnsonCook, JohnsonCookDamage, Material, Strength,
 pub mod body;
 pub mod contact;
 pub mod coupling;
+pub mod cracks;
 pub mod crater;
 pub mod dem;
 pub mod geometry;

@@ -52,6 +52,16 @@ pub struct CellRecords<R> {
     pub samples: BTreeMap<u32, Vec<R>>,
 }
 
+/// What a cell's growth reads of one unit: the abrasive mass it brought and the target mass
+/// it removed (kg/m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnitMasses {
+    /// Mass of the abrasive the unit brought (kg/m).
+    pub grain_kg_m: f64,
+    /// Target mass the unit removed (kg/m).
+    pub loss_kg_m: f64,
+}
+
 /// One job with the records it stored, as a raw results listing shows it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StoredJob<R> {

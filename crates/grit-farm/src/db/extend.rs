@@ -1,12 +1,12 @@
 //! Cells as stored, and cells that grow with their results (`docs/erosion.md`, "Extending a
 //! cell"): when the last job of such a cell completes, the same transaction hands the cell
-//! and its stored records to its scene ([`FarmScene::next_step`]), and either plans every
+//! and its units' stored masses to its scene ([`FarmScene::next_step`]), and either plans every
 //! sample for more units (they resume from the checkpoint kept after their last unit), adds
 //! samples, or finishes the cell and drops its kept checkpoints.
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{job_seed, CellRecords, NextStep, StoredCell, TargetSem, UntilSteady};
+use grit_erosion::campaign::{job_seed, NextStep, StoredCell, TargetSem, UnitMasses, UntilSteady};
 use serde::Deserialize;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
@@ -104,8 +104,10 @@ pub(super) async fn settle_cell(
     if open > 0 {
         return Ok(());
     }
+    // A unit stored before its masses had columns is read from its record.
     let rows = sqlx::query(
-        "SELECT j.sample_index, u.record
+        "SELECT j.sample_index, u.grain_kg_m, u.loss_kg_m,
+                CASE WHEN u.grain_kg_m IS NULL OR u.loss_kg_m IS NULL THEN u.record END
          FROM units u JOIN jobs j ON j.id = u.job_id
          WHERE j.campaign_id = ? AND j.cell_index = ? ORDER BY j.sample_index, u.unit",
     )
@@ -113,17 +115,23 @@ pub(super) async fn settle_cell(
     .bind(cell)
     .fetch_all(&mut **tx)
     .await?;
-    let mut samples: BTreeMap<u32, Vec<String>> = BTreeMap::new();
-    for r in rows {
+    let mut samples: BTreeMap<u32, Vec<UnitMasses>> = BTreeMap::new();
+    for r in &rows {
+        let masses = match (r.get::<Option<f64>, _>(1), r.get::<Option<f64>, _>(2)) {
+            (Some(grain_kg_m), Some(loss_kg_m)) => UnitMasses {
+                grain_kg_m,
+                loss_kg_m,
+            },
+            _ => scene.masses(r.get::<&str, _>(3))?.ok_or_else(|| {
+                Error::Internal(format!("cell {cell} grows, but its scene reads no masses"))
+            })?,
+        };
         samples
             .entry(r.get::<i64, _>(0) as u32)
             .or_default()
-            .push(r.get(1));
+            .push(masses);
     }
-    let step = scene.next_step(CellRecords {
-        cell: plan.clone(),
-        samples,
-    })?;
+    let step = scene.next_step(plan, &samples)?;
     match step {
         NextStep::ExtendImpacts(to) => {
             sqlx::query(

@@ -215,3 +215,67 @@ async fn a_repeated_complete_grows_nothing_twice() {
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
     assert_eq!(s.status(id).await.unwrap().impacts_total, 25);
 }
+
+/// What judging a finished cell costs the writer, for a cell of 25 samples × 400 impacts:
+/// its last completion (which judges it) against the others, and the read of its units'
+/// masses from their columns against parsing every record. Run by hand, on an idle machine:
+/// `cargo test --release -p grit-farm --lib settle_cost -- --ignored --nocapture`.
+#[tokio::test]
+#[ignore]
+async fn settle_cost() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec(
+        r#"{"until_steady": {"min": 400, "max": 420, "step": 20}}"#,
+        "25",
+    );
+    s.create_campaign(&sp, None).await.unwrap();
+    let mut took = Vec::new();
+    for _ in 0..25 {
+        let j = s.claim("w").await.unwrap().expect("a queued job");
+        let recs: Vec<ImpactRecord> = (1..=400).map(|k| record(&j, k, 0.0)).collect();
+        let ckpt = Some(checkpoint(&j));
+        let t = std::time::Instant::now();
+        s.complete(j.job_id, j.lease_id, imp(&recs), ckpt)
+            .await
+            .unwrap();
+        took.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let others = took[..24].iter().sum::<f64>() / 24.0;
+    println!(
+        "completion of 400 impacts: {others:.2} ms; the last, which judges the cell: {:.2} ms",
+        took[24]
+    );
+    let from = "FROM units u JOIN jobs j ON j.id = u.job_id
+                WHERE j.cell_index = 0 ORDER BY j.sample_index, u.unit";
+    let (mut columns, mut records) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..5 {
+        let t = std::time::Instant::now();
+        let rows = sqlx::query(&format!(
+            "SELECT j.sample_index, u.grain_kg_m, u.loss_kg_m {from}"
+        ))
+        .fetch_all(&s.read)
+        .await
+        .unwrap();
+        let sum: f64 = rows
+            .iter()
+            .map(|r| r.get::<f64, _>(1) + r.get::<f64, _>(2))
+            .sum();
+        columns = columns.min(t.elapsed().as_secs_f64() * 1e3);
+        let t = std::time::Instant::now();
+        let rows = sqlx::query(&format!("SELECT j.sample_index, u.record {from}"))
+            .fetch_all(&s.read)
+            .await
+            .unwrap();
+        let parsed: f64 = rows
+            .iter()
+            .map(|r| {
+                let rec: ImpactRecord = serde_json::from_str(r.get::<&str, _>(1)).unwrap();
+                rec.grain_mass_kg + rec.mass_loss_kg
+            })
+            .sum();
+        records = records.min(t.elapsed().as_secs_f64() * 1e3);
+        assert_eq!(sum, parsed);
+    }
+    println!("10000 units' masses: {columns:.2} ms from columns, {records:.2} ms from records");
+}

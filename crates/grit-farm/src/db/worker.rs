@@ -22,16 +22,16 @@ use crate::api::{Checkpoint, ClaimedJob, HeartbeatResponse};
 use crate::checkpoint::{sha256_hex, CheckpointBytes};
 use crate::error::{Error, Result};
 use crate::scenes::SceneRegistry;
-use grit_erosion::campaign::StoredCell;
+use grit_erosion::campaign::{StoredCell, UnitMasses};
 
 /// Longest failure message kept per job.
 pub(super) const MAX_ERROR_CHARS: usize = 4000;
 /// Workers silent for longer are forgotten, so the table of names cannot grow without end.
 const WORKER_FORGET_MS: i64 = 7 * 24 * 3600 * 1000;
 
-/// Unit rows inserted by one statement: 5 bound values each keeps it under SQLite's smallest
+/// Unit rows inserted by one statement: 8 bound values each keeps it under SQLite's smallest
 /// limit on bound variables (999).
-const UNIT_ROWS_PER_INSERT: usize = 150;
+const UNIT_ROWS_PER_INSERT: usize = 120;
 
 /// A checkpoint as stored.
 struct StoredCheckpoint {
@@ -109,6 +109,8 @@ pub(super) struct NewUnits {
     /// Each record's unit number (1-based) and the record as JSON, with round-trip float
     /// formatting (every f64 comes back bit for bit).
     rows: Vec<(u32, String)>,
+    /// What a cell's growth reads of each record ([`Scene::masses`]), stored beside it.
+    masses: Vec<Option<UnitMasses>>,
     /// The scene's checks of the records.
     check: Box<dyn CheckUnits>,
 }
@@ -129,6 +131,7 @@ impl Reported {
             kind: "",
             unit: "unit",
             rows: Vec::new(),
+            masses: Vec::new(),
             check: Box::new(NoUnits),
         })
     }
@@ -158,6 +161,7 @@ impl NewUnits {
             kind: S::KIND,
             unit: S::UNIT,
             rows,
+            masses: records.iter().map(S::masses).collect(),
             check: Box::new(Records::<S>(records.to_vec())),
         })
     }
@@ -769,15 +773,19 @@ async fn store_units(
         .chunks(UNIT_ROWS_PER_INSERT)
     {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
-            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms, engine) ",
+            "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms, grain_kg_m, loss_kg_m,
+                                engine) ",
         );
         qb.push_values(chunk, |mut b, (&i, &lost)| {
             let (n, json) = &units.rows[i];
+            let masses = units.masses[i];
             b.push_bind(job_id)
                 .push_bind(*n as i64)
                 .push_bind(lost)
                 .push_bind(json.as_str())
                 .push_bind(now)
+                .push_bind(masses.map(|m| m.grain_kg_m))
+                .push_bind(masses.map(|m| m.loss_kg_m))
                 .push_bind(held.engine.as_deref());
         });
         qb.build().execute(&mut **tx).await?;

@@ -344,8 +344,8 @@ pub fn spall_speed(m: &Material) -> f64 {
 }
 
 /// Runs a block of `nx` × `ny` particles at spacing `dx` whose halves fly apart at ±v/2 for the
-/// time a wave takes across half of it; returns (removed particles, mean |x| of their last
-/// place over dx, largest damage left).
+/// time a wave takes across half of it; returns (fractured particles, mean |x| of their start
+/// over dx, largest damage).
 fn spall_run(
     m: &Material,
     nx: usize,
@@ -384,11 +384,17 @@ fn spall_run(
             return Err(fail_at(&w, "spall run took over 100 000 steps".into()));
         }
     }
+    // Fractured rock stays in the world (docs/jet.md#rock-targets): failed = at D = 1.
     let p = w.particles();
-    let left: std::collections::HashSet<u32> = p.id.iter().copied().collect();
+    let failed: std::collections::HashSet<u32> =
+        p.id.iter()
+            .zip(&p.damage)
+            .filter(|(_, &d)| d >= 1.0)
+            .map(|(&id, _)| id)
+            .collect();
     let gone: Vec<f64> = ids0
         .iter()
-        .filter(|(id, _)| !left.contains(id))
+        .filter(|(id, _)| failed.contains(id))
         .map(|&(_, x)| x.abs() / dx)
         .collect();
     let mean_x = if gone.is_empty() {

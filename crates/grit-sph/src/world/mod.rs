@@ -398,23 +398,27 @@ impl World {
         !self.flow.is_empty() || self.abrasives.as_ref().is_some_and(|a| a.outflow.is_some())
     }
 
-    /// Shepard density filter (eq. 12) every `shepard_interval` steps, and deletion of particles
-    /// with D ≥ 1 and of fluid particles out of their density range.
+    /// Shepard density filter (eq. 12) every `shepard_interval` steps, and deletion of ductile
+    /// particles with D ≥ 1 and of fluid particles out of their density range.
     fn filter_and_delete(&mut self, bc: &[BodyConst]) {
         let every = self.settings.shepard_interval as u64;
         if every > 0 && self.steps.is_multiple_of(every) {
             self.filter_density_with(bc);
         }
-        // Deleted: solids at D ≥ 1, free fluid particles outside their fluid's density range.
+        // Deleted: ductile solids at D ≥ 1, free fluid particles outside their fluid's density
+        // range. Fractured JH-2 rock stays, carrying its fractured strength (the AWJ paper
+        // deletes only ductile particles; docs/jet.md#rock-targets).
         let p = &self.particles;
         let failed: Vec<bool> = (0..p.len())
             .into_par_iter()
             .par_tasks()
             .map(|i| {
-                let free_fluid = bc[p.body[i] as usize]
+                let c = &bc[p.body[i] as usize];
+                let free_fluid = c
                     .fluid
                     .filter(|_| p.flags[i] & crate::particles::KINEMATIC == 0);
-                p.damage[i] >= 1.0 || free_fluid.is_some_and(|f| f.out_of_range(p.rho[i]))
+                (p.damage[i] >= 1.0 && c.jh2.is_none())
+                    || free_fluid.is_some_and(|f| f.out_of_range(p.rho[i]))
             })
             .collect();
         if failed.iter().any(|&f| f) {

@@ -5,7 +5,9 @@ use grit_sph::{InputError, Particles, ParticlesState, Timers};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::campaign::{CellRecords, NextStep, StoredJob};
+use std::collections::BTreeMap;
+
+use crate::campaign::{CellRecords, NextStep, StoredCell, StoredJob, UnitMasses};
 use crate::impact::aggregate::Impact;
 use crate::impact::{
     run_impact_observed, GrainStart, ImpactError, ImpactOutcome, ImpactParams, StepObserver,
@@ -419,8 +421,15 @@ impl Scene for Sample {
         super::stored::results(spec, cells, raw)
     }
 
-    fn next_step(cell: &CellRecords<ImpactRecord>) -> Result<NextStep, SceneError> {
-        super::stored::grow(cell)
+    fn masses(record: &ImpactRecord) -> Option<UnitMasses> {
+        Some(super::stored::masses(record))
+    }
+
+    fn next_step(
+        cell: &StoredCell,
+        samples: &BTreeMap<u32, Vec<UnitMasses>>,
+    ) -> Result<NextStep, SceneError> {
+        super::stored::grow(cell, samples)
     }
 }
 

@@ -2,34 +2,50 @@
 //! ([`crate::campaign::StoredCell`]): the cells as they stand now, with the impacts each
 //! sample reported.
 
+use std::collections::BTreeMap;
+
 use crate::campaign::{annotate, next_step, results_json, CellRecords, NextStep, StoredJob};
+use crate::campaign::{StoredCell, UnitMasses};
 use crate::impact::aggregate::{aggregate_campaign, aggregate_cell, CellInput, Impact};
 use crate::impact::aggregate::{SampleInput, SLOPE_WINDOW};
 use crate::{ImpactParams, ImpactRecord, Sample, SceneError};
 
-/// The aggregation's input of a stored cell: an impact's grain mass and loss are all it reads.
-fn input(c: &CellRecords<ImpactRecord>) -> CellInput {
+/// The aggregation's input of stored cell `cell` whose samples reported `samples`.
+fn input(cell: &StoredCell, samples: Vec<SampleInput>) -> CellInput {
     CellInput {
-        angle_deg: c.cell.angle_deg.unwrap_or_default(),
-        shape: c.cell.shape.clone().unwrap_or_default(),
-        swept: c.cell.swept.clone(),
-        planned_samples: c.cell.samples as usize,
-        planned_impacts: c.cell.units as usize,
-        samples: c
-            .samples
-            .iter()
-            .map(|(&sample, records)| SampleInput {
-                sample,
-                impacts: records
-                    .iter()
-                    .map(|r| Impact {
-                        grain_mass_kg: r.grain_mass_kg,
-                        mass_loss_kg: r.mass_loss_kg,
-                    })
-                    .collect(),
-            })
-            .collect(),
+        angle_deg: cell.angle_deg.unwrap_or_default(),
+        shape: cell.shape.clone().unwrap_or_default(),
+        swept: cell.swept.clone(),
+        planned_samples: cell.samples as usize,
+        planned_impacts: cell.units as usize,
+        samples,
     }
+}
+
+/// An impact's grain mass and loss, all the aggregation reads of it.
+pub(crate) fn masses(r: &ImpactRecord) -> UnitMasses {
+    UnitMasses {
+        grain_kg_m: r.grain_mass_kg,
+        loss_kg_m: r.mass_loss_kg,
+    }
+}
+
+/// The samples of a cell as the aggregation reads them, from each unit's masses.
+fn samples<'a, I>(samples: impl Iterator<Item = (u32, I)>) -> Vec<SampleInput>
+where
+    I: Iterator<Item = UnitMasses> + 'a,
+{
+    samples
+        .map(|(sample, units)| SampleInput {
+            sample,
+            impacts: units
+                .map(|m| Impact {
+                    grain_mass_kg: m.grain_kg_m,
+                    mass_loss_kg: m.loss_kg_m,
+                })
+                .collect(),
+        })
+        .collect()
 }
 
 fn stored(what: &str, e: impl std::fmt::Display) -> SceneError {
@@ -42,7 +58,13 @@ pub(crate) fn results(
     cells: Vec<CellRecords<ImpactRecord>>,
     raw: Option<Vec<StoredJob<ImpactRecord>>>,
 ) -> Result<String, SceneError> {
-    let inputs: Vec<CellInput> = cells.iter().map(input).collect();
+    let inputs: Vec<CellInput> = cells
+        .iter()
+        .map(|c| {
+            let units = c.samples.iter().map(|(&s, r)| (s, r.iter().map(masses)));
+            input(&c.cell, samples(units))
+        })
+        .collect();
     // The stored spec is the parsed one written back, every default filled in, so a reader
     // of the results can rerun exactly this campaign.
     let spec: serde_json::Value =
@@ -63,8 +85,12 @@ pub(crate) fn results(
 }
 
 /// [`crate::Scene::next_step`] of the impact scene: the cell's erosion against its rules.
-pub(crate) fn grow(c: &CellRecords<ImpactRecord>) -> Result<NextStep, SceneError> {
-    let result = aggregate_cell(&input(c), SLOPE_WINDOW)
-        .map_err(|e| stored(&format!("assessing cell {}", c.cell.index), e))?;
-    Ok(next_step(&result, c.cell.until_steady, c.cell.target_sem))
+pub(crate) fn grow(
+    cell: &StoredCell,
+    units: &BTreeMap<u32, Vec<UnitMasses>>,
+) -> Result<NextStep, SceneError> {
+    let units = units.iter().map(|(&s, m)| (s, m.iter().copied()));
+    let result = aggregate_cell(&input(cell, samples(units)), SLOPE_WINDOW)
+        .map_err(|e| stored(&format!("assessing cell {}", cell.index), e))?;
+    Ok(next_step(&result, cell.until_steady, cell.target_sem))
 }

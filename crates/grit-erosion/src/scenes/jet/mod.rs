@@ -9,6 +9,7 @@
 pub mod aggregate;
 mod feed;
 mod params;
+mod rock;
 mod run;
 pub mod runs;
 mod scene;

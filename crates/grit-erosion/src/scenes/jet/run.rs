@@ -1,6 +1,7 @@
 //! One jet run, slice by slice: the world, the grain feed, the crater after each slice, and
 //! its checkpoints.
 
+use grit_sph::cracks::RockDamage;
 use grit_sph::crater::{self, CraterOptions, CraterSample};
 use grit_sph::world::GrainContacts;
 use grit_sph::{InputError, SimError, Timers, World, WorldState};
@@ -121,6 +122,10 @@ pub struct JetRun {
     world: World,
     feed: Feed,
     slices: Vec<JetSlice>,
+    /// A rock target's damage after each slice, beside `slices`; empty for a metal.
+    rock: Vec<RockDamage>,
+    /// Ids of the rock particles found detached at a slice's end, sorted (`rock::measure`).
+    detached: Vec<u32>,
 }
 
 /// What a checkpoint holds; the world goes as JSON (its optional parts are skipped when
@@ -134,6 +139,12 @@ struct Checkpoint {
     world: WorldState,
     feed: Feed,
     slices: Vec<JetSlice>,
+    /// Absent for a metal, so its checkpoints keep their bytes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    rock: Vec<RockDamage>,
+    /// Absent while no rock particle has been detached.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    detached: Vec<u32>,
 }
 
 /// Version of the checkpoint layout: the JSON, a newline and the SHA-256 of the JSON in hex.
@@ -154,6 +165,8 @@ impl JetRun {
             world,
             feed,
             slices: Vec::new(),
+            rock: Vec::new(),
+            detached: Vec::new(),
         })
     }
 
@@ -176,6 +189,11 @@ impl JetRun {
     /// Slices finished.
     pub fn slices(&self) -> &[JetSlice] {
         &self.slices
+    }
+    /// A rock target's detached mass and cracks after each slice (docs/jet.md#rock-targets),
+    /// one per slice; empty for a metal.
+    pub fn rock_damage(&self) -> &[RockDamage] {
+        &self.rock
     }
     /// Slices finished so far.
     pub fn slices_done(&self) -> u32 {
@@ -263,26 +281,33 @@ impl JetRun {
             }
         }
         let contacts = self.world.take_grain_contacts();
-        let slice = self.measure(
+        let mut detached = std::mem::take(&mut self.detached);
+        let measured = self.measure(
             k + 1,
             self.world.steps() - steps0,
             t0.elapsed().as_secs_f64(),
             &contacts,
-        )?;
+            &mut detached,
+        );
+        self.detached = detached;
+        let (slice, rock) = measured?;
         self.slices.push(slice);
+        self.rock.extend(rock);
         Ok(self.slices.last())
     }
 
     /// The crater and state now, as slice `slice`. The mass loss is the target's deleted
     /// particles (D ≥ 1) and the fragments that left the scene; the crater is measured on the
-    /// target that still hangs together with its fixed particles.
+    /// target that still hangs together with its fixed particles. A rock keeps its fractured
+    /// particles: its loss adds those that no longer hold to the rock (`rock::measure`).
     fn measure(
         &self,
         slice: u32,
         steps: u64,
         wall_s: f64,
         contacts: &GrainContacts,
-    ) -> Result<JetSlice, JetError> {
+        detached: &mut Vec<u32>,
+    ) -> Result<(JetSlice, Option<RockDamage>), JetError> {
         let w = &self.world;
         let opts = CraterOptions::for_spacing(self.params.spacing_m);
         let target = self.layout.target_body;
@@ -294,15 +319,28 @@ impl JetRun {
             .sum();
         let loss = w.bodies()[target].removed_mass_kg_m + fragments;
         let p = w.particles();
-        let (sample, c) = crater::sample(
-            w.time(),
-            p,
-            target as u32,
-            loss,
-            self.layout.surface_y_m,
-            opts,
-        )?;
-        Ok(JetSlice {
+        let (sample, c, rock) = if self.params.material.0.jh2().is_some() {
+            let (s, c, r) = super::rock::measure(
+                w,
+                target,
+                self.layout.surface_y_m,
+                self.params.spacing_m,
+                loss,
+                detached,
+            )?;
+            (s, c, Some(r))
+        } else {
+            let (s, c) = crater::sample(
+                w.time(),
+                p,
+                target as u32,
+                loss,
+                self.layout.surface_y_m,
+                opts,
+            )?;
+            (s, c, None)
+        };
+        let slice = JetSlice {
             slice,
             sample,
             half_depth_width_m: c.half_depth_width_m,
@@ -315,7 +353,8 @@ impl JetRun {
             water_fed_kg_m: w.inflows().iter().map(|i| i.mass_kg_m).sum(),
             wall_s,
             grain_hits: GrainHits::of(contacts),
-        })
+        };
+        Ok((slice, rock))
     }
 
     /// The state after the last finished slice, as bytes: JSON (floats kept bit for bit), a
@@ -329,6 +368,8 @@ impl JetRun {
             world: self.world.state(),
             feed: self.feed.clone(),
             slices: self.slices.clone(),
+            rock: self.rock.clone(),
+            detached: self.detached.clone(),
         };
         let mut bytes = serde_json::to_vec(&c).expect("a checkpoint always serialises");
         let digest = format!("{:x}", sha2::Sha256::digest(&bytes));
@@ -393,6 +434,19 @@ impl JetRun {
                 i + 1
             )));
         }
+        let want = if c.params.material.0.jh2().is_some() {
+            c.slices.len()
+        } else {
+            0
+        };
+        if c.rock.len() != want {
+            return Err(JetError::Checkpoint(format!(
+                "holds {} rock damage records for its {} slices of {}",
+                c.rock.len(),
+                c.slices.len(),
+                c.params.material.0.name
+            )));
+        }
         let world = World::from_state(c.world)
             .map_err(|e| JetError::Checkpoint(format!("cannot decode: {e}")))?;
         let n = c.slices.len() as u32;
@@ -417,6 +471,8 @@ impl JetRun {
             world,
             feed: c.feed,
             slices: c.slices,
+            rock: c.rock,
+            detached: c.detached,
         })
     }
 }
