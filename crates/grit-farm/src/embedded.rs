@@ -138,6 +138,16 @@ fn own_engine(commit: Option<String>) -> Result<OwnEngine, EmbeddedError> {
     })
 }
 
+/// The database of folder `out`, as this grit's coordinator (built from `commit`) opens it.
+async fn open_store(out: &std::path::Path, commit: Option<String>) -> Result<Store, EmbeddedError> {
+    let path = out.join("grit.db");
+    let mut store = Store::open(&path, Duration::from_secs(120), 3)
+        .await
+        .map_err(|source| EmbeddedError::Database { path, source })?;
+    store.own = own_engine(commit)?;
+    Ok(store)
+}
+
 /// Campaign `id` (of `spec`) pinned to another engine than `store`'s own: (pinned, own).
 async fn mismatch(
     store: &Store,
@@ -158,17 +168,10 @@ pub async fn engine_mismatch(
     spec: &AnySpec,
     out: &std::path::Path,
 ) -> Result<Option<(String, String)>, EmbeddedError> {
-    let db_path = out.join("grit.db");
-    if !db_path.exists() {
+    if !out.join("grit.db").exists() {
         return Ok(None);
     }
-    let mut store = Store::open(&db_path, Duration::from_secs(120), 3)
-        .await
-        .map_err(|source| EmbeddedError::Database {
-            path: db_path.clone(),
-            source,
-        })?;
-    store.own = own_engine(None)?;
+    let store = open_store(out, None).await?;
     let Some(c) = store.list_campaigns().await?.into_iter().next() else {
         return Ok(None);
     };
@@ -190,14 +193,7 @@ pub async fn run(
         path: opts.out.clone(),
         source,
     })?;
-    let db_path = opts.out.join("grit.db");
-    let mut store = Store::open(&db_path, Duration::from_secs(120), 3)
-        .await
-        .map_err(|source| EmbeddedError::Database {
-            path: db_path.clone(),
-            source,
-        })?;
-    store.own = own_engine(opts.commit.clone())?;
+    let store = open_store(&opts.out, opts.commit.clone()).await?;
     // Nothing else uses this file, so leases left by an interrupted run are dead.
     store.requeue_all_leases().await?;
     let key = any_campaign_key(spec)?;
