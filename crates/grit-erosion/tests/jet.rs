@@ -271,6 +271,35 @@ fn sandstone_keeps_fractured_rock_loses_mass_and_resumes_bit_for_bit() {
     assert!(state(&whole) == state(&resumed), "the resumed run differs");
 }
 
+// Detachment is checked on a clock of its own, not at slice ends, so the loss of a rock run at
+// a given time does not depend on how the run was cut into slices.
+#[test]
+fn a_rock_loses_the_same_mass_whatever_its_slice_length() {
+    let run = |slice_ms: f64| {
+        let mut run = JetRun::new(
+            JetParams {
+                slice_ms,
+                ..tiny_rock()
+            },
+            3,
+        )
+        .unwrap();
+        while !run.finished() {
+            run.run_next_slice().unwrap();
+        }
+        run
+    };
+    let (coarse, fine) = (run(0.001), run(0.00025));
+    assert_eq!(fine.slices().len(), 4 * coarse.slices().len());
+    for (k, c) in coarse.slices().iter().enumerate() {
+        let f = &fine.slices()[4 * k + 3];
+        assert_eq!(c.sample, f.sample, "slice {}", k + 1);
+        assert_eq!(c.rock, f.rock, "slice {}", k + 1);
+    }
+    let last = coarse.slices().last().unwrap();
+    assert!(last.rock.unwrap().detached_kg_m > 0.0, "{last:?}");
+}
+
 #[test]
 fn a_metal_run_keeps_no_rock_records() {
     let mut run = JetRun::new(tiny(), 5).unwrap();
