@@ -300,6 +300,37 @@ fn a_rock_loses_the_same_mass_whatever_its_slice_length() {
     assert!(last.rock.unwrap().detached_kg_m > 0.0, "{last:?}");
 }
 
+// A rock checkpoint written before the slices carried their damage kept it in a list beside
+// them: it reads into the slices, and a list of the wrong length is refused.
+#[test]
+fn an_older_rock_checkpoint_reads_its_damage_into_the_slices() {
+    let p = tiny_rock();
+    let mut run = JetRun::new(p.clone(), 3).unwrap();
+    run.run_next_slice().unwrap();
+    run.run_next_slice().unwrap();
+    let bytes = run.checkpoint();
+    let body = &bytes[..bytes.iter().rposition(|&b| b == b'\n').unwrap()];
+    let mut v: serde_json::Value = serde_json::from_slice(body).unwrap();
+    let rock: Vec<serde_json::Value> = v["slices"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .map(|s| s.as_object_mut().unwrap().remove("rock").unwrap())
+        .collect();
+    v["rock"] = serde_json::Value::Array(rock);
+    let written = |v: &serde_json::Value| {
+        let mut b = serde_json::to_vec(v).unwrap();
+        let sum = format!("{:x}", sha2::Sha256::digest(&b));
+        b.push(b'\n');
+        b.extend_from_slice(sum.as_bytes());
+        b
+    };
+    let back = JetRun::resume(&p, 3, &written(&v)).unwrap();
+    assert_eq!(back.slices(), run.slices());
+    v["rock"].as_array_mut().unwrap().pop();
+    assert!(JetRun::resume(&p, 3, &written(&v)).is_err());
+}
+
 #[test]
 fn a_metal_run_keeps_no_rock_records() {
     let mut run = JetRun::new(tiny(), 5).unwrap();
