@@ -29,6 +29,14 @@ fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .install(f)
 }
 
+/// Checkpoint bytes around `json`: the JSON, a newline and the JSON's SHA-256 in hex.
+fn sealed(json: &[u8]) -> Vec<u8> {
+    let mut b = json.to_vec();
+    b.push(b'\n');
+    b.extend_from_slice(format!("{:x}", sha2::Sha256::digest(json)).as_bytes());
+    b
+}
+
 /// Run `p` seeded `seed` whole on two threads, and again on one thread resumed from its
 /// checkpoint after two slices.
 fn whole_and_resumed(p: &JetParams, seed: u64) -> (JetRun, JetRun) {
@@ -73,13 +81,7 @@ fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
     let bytes = whole.checkpoint();
     let cut = bytes.iter().rposition(|&b| b == b'\n').unwrap();
     let json = &bytes[..cut];
-    let seal = |json: &[u8]| {
-        let mut b = json.to_vec();
-        b.push(b'\n');
-        b.extend_from_slice(format!("{:x}", sha2::Sha256::digest(json)).as_bytes());
-        b
-    };
-    assert_eq!(seal(json), bytes);
+    assert_eq!(sealed(json), bytes);
     let refused = |b: &[u8]| JetRun::from_checkpoint(b).err().unwrap().to_string();
     let mut flipped = bytes.clone();
     flipped[cut / 2] ^= 0x01;
@@ -106,7 +108,7 @@ fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
     let edited = |edit: &dyn Fn(&mut serde_json::Value)| {
         let mut v: serde_json::Value = serde_json::from_slice(json).unwrap();
         edit(&mut v);
-        JetRun::from_checkpoint(&seal(&serde_json::to_vec(&v).unwrap()))
+        JetRun::from_checkpoint(&sealed(&serde_json::to_vec(&v).unwrap()))
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default()
@@ -318,13 +320,7 @@ fn an_older_rock_checkpoint_reads_its_damage_into_the_slices() {
         .map(|s| s.as_object_mut().unwrap().remove("rock").unwrap())
         .collect();
     v["rock"] = serde_json::Value::Array(rock);
-    let written = |v: &serde_json::Value| {
-        let mut b = serde_json::to_vec(v).unwrap();
-        let sum = format!("{:x}", sha2::Sha256::digest(&b));
-        b.push(b'\n');
-        b.extend_from_slice(sum.as_bytes());
-        b
-    };
+    let written = |v: &serde_json::Value| sealed(&serde_json::to_vec(v).unwrap());
     let back = JetRun::resume(&p, 3, &written(&v)).unwrap();
     assert_eq!(back.slices(), run.slices());
     v["rock"].as_array_mut().unwrap().pop();
