@@ -55,13 +55,7 @@ fn a_small_jet_prints_its_series_and_writes_snapshots() {
     let v = json_of(&out);
     let series = v["series"].as_array().unwrap();
     assert_eq!(series.len(), 3);
-    for key in [
-        "t_s",
-        "mass_loss_kg_m",
-        "crater_depth_m",
-        "crater_width_m",
-        "max_plastic_strain",
-    ] {
+    for key in grit_sph::crater::CraterSample::FIELDS {
         assert!(series[2][key].is_number(), "{key} missing");
     }
     assert!((series[2]["t_s"].as_f64().unwrap() - 3e-6).abs() < 1e-8);

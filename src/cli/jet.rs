@@ -218,10 +218,9 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
         series: run
             .slices()
             .iter()
-            .enumerate()
-            .map(|(k, s)| SeriesPoint {
+            .map(|s| SeriesPoint {
                 sample: s.sample,
-                rock: run.rock_damage().get(k).copied(),
+                rock: s.rock,
             })
             .collect(),
         slices: run.slices(),
@@ -265,7 +264,7 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
                 v_n
             );
         }
-        if !run.rock_damage().is_empty() {
+        if run.slices().iter().any(|s| s.rock.is_some()) {
             say!(
                 "{:>9} {:>12} {:>10} {:>7} {:>11} {:>11} {:>11}",
                 "t (ms)",
@@ -276,7 +275,7 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
                 "below Cd µm",
                 "damage mm²"
             );
-            for (s, r) in run.slices().iter().zip(run.rock_damage()) {
+            for (s, r) in run.slices().iter().filter_map(|s| Some((s, s.rock?))) {
                 say!(
                     "{:>9.4} {:>12.4e} {:>10} {:>7} {:>11.0} {:>11.0} {:>11.4}",
                     s.sample.t_s * 1e3,

@@ -29,6 +29,14 @@ fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .install(f)
 }
 
+/// Checkpoint bytes around `json`: the JSON, a newline and the JSON's SHA-256 in hex.
+fn sealed(json: &[u8]) -> Vec<u8> {
+    let mut b = json.to_vec();
+    b.push(b'\n');
+    b.extend_from_slice(format!("{:x}", sha2::Sha256::digest(json)).as_bytes());
+    b
+}
+
 /// Run `p` seeded `seed` whole on two threads, and again on one thread resumed from its
 /// checkpoint after two slices.
 fn whole_and_resumed(p: &JetParams, seed: u64) -> (JetRun, JetRun) {
@@ -73,13 +81,7 @@ fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
     let bytes = whole.checkpoint();
     let cut = bytes.iter().rposition(|&b| b == b'\n').unwrap();
     let json = &bytes[..cut];
-    let seal = |json: &[u8]| {
-        let mut b = json.to_vec();
-        b.push(b'\n');
-        b.extend_from_slice(format!("{:x}", sha2::Sha256::digest(json)).as_bytes());
-        b
-    };
-    assert_eq!(seal(json), bytes);
+    assert_eq!(sealed(json), bytes);
     let refused = |b: &[u8]| JetRun::from_checkpoint(b).err().unwrap().to_string();
     let mut flipped = bytes.clone();
     flipped[cut / 2] ^= 0x01;
@@ -106,7 +108,7 @@ fn a_resumed_run_gives_the_bits_of_an_unbroken_one_on_any_thread_count() {
     let edited = |edit: &dyn Fn(&mut serde_json::Value)| {
         let mut v: serde_json::Value = serde_json::from_slice(json).unwrap();
         edit(&mut v);
-        JetRun::from_checkpoint(&seal(&serde_json::to_vec(&v).unwrap()))
+        JetRun::from_checkpoint(&sealed(&serde_json::to_vec(&v).unwrap()))
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default()
@@ -269,6 +271,60 @@ fn sandstone_keeps_fractured_rock_loses_mass_and_resumes_bit_for_bit() {
         serde_json::to_string(&(run.world(), slices, bulking, rock)).unwrap()
     };
     assert!(state(&whole) == state(&resumed), "the resumed run differs");
+}
+
+// Detachment is checked on a clock of its own, not at slice ends, so the loss of a rock run at
+// a given time does not depend on how the run was cut into slices.
+#[test]
+fn a_rock_loses_the_same_mass_whatever_its_slice_length() {
+    let run = |slice_ms: f64| {
+        let mut run = JetRun::new(
+            JetParams {
+                slice_ms,
+                ..tiny_rock()
+            },
+            3,
+        )
+        .unwrap();
+        while !run.finished() {
+            run.run_next_slice().unwrap();
+        }
+        run
+    };
+    let (coarse, fine) = (run(0.001), run(0.00025));
+    assert_eq!(fine.slices().len(), 4 * coarse.slices().len());
+    for (k, c) in coarse.slices().iter().enumerate() {
+        let f = &fine.slices()[4 * k + 3];
+        assert_eq!(c.sample, f.sample, "slice {}", k + 1);
+        assert_eq!(c.rock, f.rock, "slice {}", k + 1);
+    }
+    let last = coarse.slices().last().unwrap();
+    assert!(last.rock.unwrap().detached_kg_m > 0.0, "{last:?}");
+}
+
+// A rock checkpoint written before the slices carried their damage kept it in a list beside
+// them: it reads into the slices, and a list of the wrong length is refused.
+#[test]
+fn an_older_rock_checkpoint_reads_its_damage_into_the_slices() {
+    let p = tiny_rock();
+    let mut run = JetRun::new(p.clone(), 3).unwrap();
+    run.run_next_slice().unwrap();
+    run.run_next_slice().unwrap();
+    let bytes = run.checkpoint();
+    let body = &bytes[..bytes.iter().rposition(|&b| b == b'\n').unwrap()];
+    let mut v: serde_json::Value = serde_json::from_slice(body).unwrap();
+    let rock: Vec<serde_json::Value> = v["slices"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .map(|s| s.as_object_mut().unwrap().remove("rock").unwrap())
+        .collect();
+    v["rock"] = serde_json::Value::Array(rock);
+    let written = |v: &serde_json::Value| sealed(&serde_json::to_vec(v).unwrap());
+    let back = JetRun::resume(&p, 3, &written(&v)).unwrap();
+    assert_eq!(back.slices(), run.slices());
+    v["rock"].as_array_mut().unwrap().pop();
+    assert!(JetRun::resume(&p, 3, &written(&v)).is_err());
 }
 
 #[test]

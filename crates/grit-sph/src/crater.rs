@@ -72,39 +72,19 @@ pub struct CraterSample {
     pub max_plastic_strain: f64,
 }
 
-/// The time-series point of target body `body` at time `t_s`, and its crater: Cd and Cw from
-/// its particles that hang together with its fixed (kinematic) ones ([`attached`]; all of them
-/// when it has none), the largest plastic strain among those, and `mass_loss_kg_m` as the
-/// caller books it.
-pub fn sample(
-    t_s: f64,
-    particles: &Particles,
-    body: u32,
-    mass_loss_kg_m: f64,
-    surface_y_m: f64,
-    opts: CraterOptions,
-) -> Result<(CraterSample, Crater), InputError> {
-    let of_body = body_particles(particles, body);
-    let pos: Vec<Vector> = of_body.iter().map(|&i| particles.pos[i]).collect();
-    let fixed = fixed_of(particles, &of_body);
-    let keep = if fixed.iter().any(|&f| f) {
-        attached(&pos, &fixed, opts.link_m)?
-    } else {
-        vec![true; pos.len()]
-    };
-    sample_kept(
-        t_s,
-        particles,
-        body,
-        mass_loss_kg_m,
-        surface_y_m,
-        opts,
-        &keep,
-    )
+impl CraterSample {
+    /// The JSON keys of a sample: the fields every point of a jet series carries.
+    pub const FIELDS: [&'static str; 5] = [
+        "t_s",
+        "mass_loss_kg_m",
+        "crater_depth_m",
+        "crater_width_m",
+        "max_plastic_strain",
+    ];
 }
 
 /// The indices of body `body`'s particles, in particle order: the order of the masks that
-/// [`sample_kept`] reads.
+/// [`sample`] reads.
 pub fn body_particles(particles: &Particles, body: u32) -> Vec<usize> {
     (0..particles.len())
         .filter(|&i| particles.body[i] == body)
@@ -119,19 +99,35 @@ pub fn fixed_of(particles: &Particles, of_body: &[usize]) -> Vec<bool> {
         .collect()
 }
 
-/// [`sample`] with the caller's choice of the particles that still belong to the target:
-/// `keep`, one entry per particle of [`body_particles`] (a rock keeps the ones
-/// `cracks::held` names).
-pub fn sample_kept(
+/// The time-series point of target body `body` at time `t_s`, and its crater: Cd and Cw from
+/// the particles `keep` names, one entry per particle of [`body_particles`] (a rock keeps the
+/// ones `cracks::held` names), or when `None` from those that hang together with its fixed
+/// (kinematic) ones ([`attached`]; all of them when it has none); the largest plastic strain
+/// among those, and `mass_loss_kg_m` as the caller books it.
+pub fn sample(
     t_s: f64,
     particles: &Particles,
     body: u32,
     mass_loss_kg_m: f64,
     surface_y_m: f64,
     opts: CraterOptions,
-    keep: &[bool],
+    keep: Option<&[bool]>,
 ) -> Result<(CraterSample, Crater), InputError> {
     let of_body = body_particles(particles, body);
+    let pos: Vec<Vector> = of_body.iter().map(|&i| particles.pos[i]).collect();
+    let found;
+    let keep = match keep {
+        Some(k) => k,
+        None => {
+            let fixed = fixed_of(particles, &of_body);
+            found = if fixed.iter().any(|&f| f) {
+                attached(&pos, &fixed, opts.link_m)?
+            } else {
+                vec![true; pos.len()]
+            };
+            &found
+        }
+    };
     if keep.len() != of_body.len() {
         return Err(InputError::new(
             "crater.keep",
@@ -142,7 +138,6 @@ pub fn sample_kept(
             ),
         ));
     }
-    let pos: Vec<Vector> = of_body.iter().map(|&i| particles.pos[i]).collect();
     let mut kept = Vec::with_capacity(pos.len());
     let mut max_eps = 0.0f64;
     for (k, &i) in of_body.iter().enumerate() {
@@ -466,7 +461,16 @@ mod tests {
         p.pos.push(Vector::new(0.0, 3.0 * S));
         p.body.push(0);
         p.eps_p.push(9.0);
-        let (s, c) = sample(1e-3, &p, 1, 2.5e-6, 0.0, CraterOptions::for_spacing(S)).unwrap();
+        let (s, c) = sample(
+            1e-3,
+            &p,
+            1,
+            2.5e-6,
+            0.0,
+            CraterOptions::for_spacing(S),
+            None,
+        )
+        .unwrap();
         assert_eq!(c.depth_m, s.crater_depth_m);
         assert!((s.crater_depth_m - 5.0 * S).abs() < 1e-15);
         assert!((s.crater_width_m - 20.0 * S * (1.0 - 0.1)).abs() < 1e-12);
@@ -475,17 +479,11 @@ mod tests {
             (1e-3, 2.5e-6, 0.25)
         );
         let json = serde_json::to_string(&s).unwrap();
-        for key in [
-            "t_s",
-            "mass_loss_kg_m",
-            "crater_depth_m",
-            "crater_width_m",
-            "max_plastic_strain",
-        ] {
+        for key in CraterSample::FIELDS {
             assert!(json.contains(key), "{json}");
         }
         assert_eq!(
-            sample(0.0, &p, 7, 0.0, 0.0, CraterOptions::for_spacing(S))
+            sample(0.0, &p, 7, 0.0, 0.0, CraterOptions::for_spacing(S), None)
                 .unwrap_err()
                 .field,
             "crater.positions"
@@ -511,7 +509,7 @@ mod tests {
             p.eps_p.push(7.0);
             p.flags.push(0);
         }
-        let (s, _) = sample(0.0, &p, 1, 0.0, 0.0, CraterOptions::for_spacing(S)).unwrap();
+        let (s, _) = sample(0.0, &p, 1, 0.0, 0.0, CraterOptions::for_spacing(S), None).unwrap();
         assert!(
             (s.crater_depth_m - 5.0 * S).abs() < 1e-12,
             "{}",

@@ -38,6 +38,31 @@ fn jh2_material(
     }
 }
 
+/// The Barre-granite JH-2 strength (Wang, Yin & Luo 2018, eq. 38's A, N, B, M, C) with the
+/// HEL, P_HEL and T given (Pa); both presets share its dimensionless shape.
+fn barre_shape(hel_pa: f64, p_hel_pa: f64, t_pa: f64) -> Jh2Strength {
+    Jh2Strength {
+        a: 1.01,
+        n: 0.76,
+        b: 0.68,
+        m: 0.83,
+        c: 0.005,
+        ref_strain_rate_s: 1.0,
+        sfmax: 1.0,
+        hel_pa,
+        p_hel_pa,
+        t_pa,
+    }
+}
+
+/// The Barre-granite JH-2 damage constants (Wang, Yin & Luo 2018, eq. 39's D1, D2), no ε_f,min
+/// (docs/references.md#rock-presets).
+const BARRE_DAMAGE: Jh2Damage = Jh2Damage {
+    d1: 0.005,
+    d2: 0.7,
+    ef_min: 0.0,
+};
+
 impl Material {
     /// Granite: the JH-2 set of Barre granite (Wang, Yin & Luo, Appl. Sci. 8:1675, 2018), the
     /// AWJ paper's granite source; σ*_fmax and ε_f,min are grit's (docs/references.md#rock-presets).
@@ -46,23 +71,8 @@ impl Material {
             "granite",
             21.9e9,
             790.0,
-            Jh2Strength {
-                a: 1.01,
-                n: 0.76,
-                b: 0.68,
-                m: 0.83,
-                c: 0.005,
-                ref_strain_rate_s: 1.0,
-                sfmax: 1.0,
-                hel_pa: 4.5e9,
-                p_hel_pa: 2.93e9,
-                t_pa: 12e6,
-            },
-            Jh2Damage {
-                d1: 0.005,
-                d2: 0.7,
-                ef_min: 0.0,
-            },
+            barre_shape(4.5e9, 2.93e9, 12e6),
+            BARRE_DAMAGE,
             PolynomialEos {
                 rho0_kg_m3: 2660.0,
                 k1_pa: 25.7e9,
@@ -85,23 +95,8 @@ impl Material {
             "sandstone",
             6.4e9,
             920.0,
-            Jh2Strength {
-                a: 1.01,
-                n: 0.76,
-                b: 0.68,
-                m: 0.83,
-                c: 0.005,
-                ref_strain_rate_s: 1.0,
-                sfmax: 1.0,
-                hel_pa: 1.11e9,
-                p_hel_pa: 0.617e9,
-                t_pa: 4e6,
-            },
-            Jh2Damage {
-                d1: 0.005,
-                d2: 0.7,
-                ef_min: 0.0,
-            },
+            barre_shape(1.11e9, 0.617e9, 4e6),
+            BARRE_DAMAGE,
             PolynomialEos {
                 rho0_kg_m3: 2400.0,
                 k1_pa: k1,
@@ -117,8 +112,17 @@ impl Material {
 /// stress σ with σ = σ_HEL A (σ/(3 P_HEL) + T*)^N, where a uniaxial stress state has P = σ/3
 /// and von Mises stress σ (eq. 38 at D = 0), solved by bisection.
 pub fn uniaxial_compressive_strength(s: &Jh2Strength) -> f64 {
-    let f = |sig: f64| sig - s.sigma_hel() * s.intact(sig / 3.0, 0.0);
-    let (mut lo, mut hi) = (0.0, s.sigma_hel() * s.a * 10.0);
+    bisect(
+        |sig| sig - s.sigma_hel() * s.intact(sig / 3.0, 0.0),
+        0.0,
+        s.sigma_hel() * s.a * 10.0,
+    )
+}
+
+/// The root in [lo, hi] of `f`, negative below it and positive above, by 200 bisections: the
+/// uniaxial strengths of eq. 38 (this module and the rock verification rows).
+pub fn bisect(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
+    let (mut lo, mut hi) = (lo, hi);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         if f(mid) > 0.0 {

@@ -37,6 +37,7 @@ fn slice(k: u32) -> JetSlice {
         water_fed_kg_m: 0.0,
         wall_s: 0.1,
         grain_hits: None,
+        rock: None,
     }
 }
 

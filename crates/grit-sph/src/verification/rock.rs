@@ -163,17 +163,11 @@ fn uniaxial_yield(l: &Jh2Laws, g: f64, sign: f64, scale: f64) -> f64 {
 /// σ = σ_HEL A ((T − σ/3)/P_HEL)^N (P = −σ/3), by bisection; below 3T.
 fn uniaxial_tensile_strength(l: &Jh2Laws) -> f64 {
     let s = &l.strength;
-    let f = |sig: f64| sig - s.sigma_hel() * s.intact(-sig / 3.0, 0.0);
-    let (mut lo, mut hi) = (0.0, 3.0 * s.t_pa);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) > 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    crate::rock::bisect(
+        |sig| sig - s.sigma_hel() * s.intact(-sig / 3.0, 0.0),
+        0.0,
+        3.0 * s.t_pa,
+    )
 }
 
 /// Uniaxial compression and tension, and hydrostatic tension, of one preset.

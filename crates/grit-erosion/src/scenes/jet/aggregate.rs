@@ -30,6 +30,7 @@ use crate::campaign::Scene;
 use crate::impact::steady::{compare, Incubation, STEADY_INCUBATED_PERCENT, STEADY_SIGMAS};
 use crate::stats::{slope_fit, SlopeFit};
 use crate::stats::{stats, AggregateError, Stats};
+use grit_sph::cracks::RockDamage;
 
 /// Fewest points of the stage-3 window: two halves of three, the fewest a slope with a
 /// standard error needs.
@@ -90,6 +91,10 @@ pub struct JetSampleResult {
     /// Its own least-squares slope of mass loss against time over the cell's stage-3 window
     /// (kg/m/s); `null` when the window is too short or the sample has not reached its end.
     pub stage3_slope_kg_m_s: Option<f64>,
+    /// A rock target's detached mass and cracks at the last slice (docs/jet.md#rock-targets);
+    /// absent for a metal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rock: Option<RockDamage>,
 }
 
 /// One point of a cell's mean series: the mean over the samples that reached the slice.
@@ -596,6 +601,7 @@ pub fn aggregate_jet_cell(input: &JetCellInput) -> Result<JetCellResult, Aggrega
                 max_plastic_strain: last.sample.max_plastic_strain,
                 onset_slice: onset(&s.slices),
                 stage3_slope_kg_m_s: sample_slope(s, first, mean_series.len()),
+                rock: last.rock,
             })
         })
         .collect();
@@ -690,6 +696,7 @@ mod tests {
             water_fed_kg_m: 0.0,
             wall_s: 0.5,
             grain_hits: None,
+            rock: None,
         }
     }
 

@@ -49,6 +49,10 @@ pub struct JetSlice {
     /// it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grain_hits: Option<GrainHits>,
+    /// A rock target's detached mass and cracks at the slice's end (docs/jet.md#rock-targets),
+    /// so a farm's stored slices carry them; absent for a metal, whose records keep their bytes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rock: Option<RockDamage>,
 }
 
 /// The grains' contacts with the target in one slice (`World::take_grain_contacts`): how fast
@@ -122,9 +126,7 @@ pub struct JetRun {
     world: World,
     feed: Feed,
     slices: Vec<JetSlice>,
-    /// A rock target's damage after each slice, beside `slices`; empty for a metal.
-    rock: Vec<RockDamage>,
-    /// Ids of the rock particles found detached at a slice's end, sorted (`rock::measure`).
+    /// Ids of the rock particles found detached so far, sorted (`rock::detach`).
     detached: Vec<u32>,
 }
 
@@ -139,8 +141,9 @@ struct Checkpoint {
     world: WorldState,
     feed: Feed,
     slices: Vec<JetSlice>,
-    /// Absent for a metal, so its checkpoints keep their bytes.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    /// A rock's damage per slice as checkpoints kept it before the slices carried it: read
+    /// into the slices, never written.
+    #[serde(default, skip_serializing)]
     rock: Vec<RockDamage>,
     /// Absent while no rock particle has been detached.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -165,7 +168,6 @@ impl JetRun {
             world,
             feed,
             slices: Vec::new(),
-            rock: Vec::new(),
             detached: Vec::new(),
         })
     }
@@ -192,8 +194,8 @@ impl JetRun {
     }
     /// A rock target's detached mass and cracks after each slice (docs/jet.md#rock-targets),
     /// one per slice; empty for a metal.
-    pub fn rock_damage(&self) -> &[RockDamage] {
-        &self.rock
+    pub fn rock_damage(&self) -> Vec<RockDamage> {
+        self.slices.iter().filter_map(|s| s.rock).collect()
     }
     /// Slices finished so far.
     pub fn slices_done(&self) -> u32 {
@@ -269,11 +271,22 @@ impl JetRun {
         self.world.timers_mut().reset();
         // A slice abandoned by `cancel` may have left touches of its own in the log.
         self.world.take_grain_contacts();
+        let rock = self.params.material.0.jh2().is_some();
+        let every = super::rock::detach_every_s(self.params.spacing_m);
         while self.world.time() < t_end {
             if cancel() {
                 return Ok(None);
             }
+            let before = self.world.time();
             self.world.step()?;
+            if rock && (self.world.time() / every).floor() > (before / every).floor() {
+                super::rock::detach(
+                    &self.world,
+                    self.layout.target_body,
+                    self.params.spacing_m,
+                    &mut self.detached,
+                )?;
+            }
             self.feed
                 .release(&mut self.world, &self.params, &self.layout, self.seed)?;
             if let Some(f) = observe.as_mut() {
@@ -281,33 +294,27 @@ impl JetRun {
             }
         }
         let contacts = self.world.take_grain_contacts();
-        let mut detached = std::mem::take(&mut self.detached);
-        let measured = self.measure(
+        let slice = self.measure(
             k + 1,
             self.world.steps() - steps0,
             t0.elapsed().as_secs_f64(),
             &contacts,
-            &mut detached,
-        );
-        self.detached = detached;
-        let (slice, rock) = measured?;
+        )?;
         self.slices.push(slice);
-        self.rock.extend(rock);
         Ok(self.slices.last())
     }
 
     /// The crater and state now, as slice `slice`. The mass loss is the target's deleted
     /// particles (D ≥ 1) and the fragments that left the scene; the crater is measured on the
     /// target that still hangs together with its fixed particles. A rock keeps its fractured
-    /// particles: its loss adds those that no longer hold to the rock (`rock::measure`).
+    /// particles: its loss adds those found detached (`rock::measure`).
     fn measure(
         &self,
         slice: u32,
         steps: u64,
         wall_s: f64,
         contacts: &GrainContacts,
-        detached: &mut Vec<u32>,
-    ) -> Result<(JetSlice, Option<RockDamage>), JetError> {
+    ) -> Result<JetSlice, JetError> {
         let w = &self.world;
         let opts = CraterOptions::for_spacing(self.params.spacing_m);
         let target = self.layout.target_body;
@@ -326,7 +333,7 @@ impl JetRun {
                 self.layout.surface_y_m,
                 self.params.spacing_m,
                 loss,
-                detached,
+                &self.detached,
             )?;
             (s, c, Some(r))
         } else {
@@ -337,6 +344,7 @@ impl JetRun {
                 loss,
                 self.layout.surface_y_m,
                 opts,
+                None,
             )?;
             (s, c, None)
         };
@@ -353,8 +361,9 @@ impl JetRun {
             water_fed_kg_m: w.inflows().iter().map(|i| i.mass_kg_m).sum(),
             wall_s,
             grain_hits: GrainHits::of(contacts),
+            rock,
         };
-        Ok((slice, rock))
+        Ok(slice)
     }
 
     /// The state after the last finished slice, as bytes: JSON (floats kept bit for bit), a
@@ -368,7 +377,7 @@ impl JetRun {
             world: self.world.state(),
             feed: self.feed.clone(),
             slices: self.slices.clone(),
-            rock: self.rock.clone(),
+            rock: Vec::new(),
             detached: self.detached.clone(),
         };
         let mut bytes = serde_json::to_vec(&c).expect("a checkpoint always serialises");
@@ -410,7 +419,7 @@ impl JetRun {
                 ));
             }
         }
-        let c: Checkpoint =
+        let mut c: Checkpoint =
             serde_json::from_slice(body).map_err(|e| bad(format!("cannot decode: {e}")))?;
         let expected = if sum.is_some() {
             CHECKPOINT_VERSION
@@ -434,16 +443,24 @@ impl JetRun {
                 i + 1
             )));
         }
-        let want = if c.params.material.0.jh2().is_some() {
-            c.slices.len()
-        } else {
-            0
-        };
-        if c.rock.len() != want {
+        if !c.rock.is_empty() {
+            if c.rock.len() != c.slices.len() {
+                return Err(JetError::Checkpoint(format!(
+                    "holds {} rock damage records for its {} slices",
+                    c.rock.len(),
+                    c.slices.len()
+                )));
+            }
+            for (s, r) in c.slices.iter_mut().zip(&c.rock) {
+                s.rock = Some(*r);
+            }
+        }
+        let rock = c.params.material.0.jh2().is_some();
+        if let Some(s) = c.slices.iter().find(|s| s.rock.is_some() != rock) {
             return Err(JetError::Checkpoint(format!(
-                "holds {} rock damage records for its {} slices of {}",
-                c.rock.len(),
-                c.slices.len(),
+                "slice {} {} rock damage, but its target is {}",
+                s.slice,
+                if rock { "lacks" } else { "holds" },
                 c.params.material.0.name
             )));
         }
@@ -471,7 +488,6 @@ impl JetRun {
             world,
             feed: c.feed,
             slices: c.slices,
-            rock: c.rock,
             detached: c.detached,
         })
     }

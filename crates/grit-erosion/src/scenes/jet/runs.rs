@@ -139,6 +139,7 @@ mod tests {
                 water_fed_kg_m: 0.0,
                 wall_s: 0.1,
                 grain_hits: None,
+                rock: None,
             })
             .collect();
         JetRunRecord {
