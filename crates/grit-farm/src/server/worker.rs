@@ -60,11 +60,9 @@ impl Report {
         };
         // Decoding a checkpoint of a large surface or a jet's world takes milliseconds: off
         // the async threads.
-        let checked = tokio::task::spawn_blocking(move || {
-            scene.verify_upload(&c, job, &stored.params, stored.seed)
-        })
-        .await
-        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
+        let checked = tokio::task::spawn_blocking(move || scene.verify_upload(&c, &stored))
+            .await
+            .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
         let bytes = checked.map_err(|e| {
             tracing::warn!(job, error = %e, "checkpoint refused; nothing of the request stored");
             Error::invalid(e.field, e.rule)
