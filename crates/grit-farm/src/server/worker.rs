@@ -106,7 +106,7 @@ pub fn router() -> Router<AppState> {
 #[derive(utoipa::OpenApi)]
 #[openapi(
     paths(claim, heartbeat, complete, fail, release),
-    components(schemas(HeartbeatRequest, CompleteRequest, FailRequest, ReleaseRequest))
+    components(schemas(HeartbeatRequest, CompleteRequest, FailRequest))
 )]
 pub struct Doc;
 
@@ -288,7 +288,7 @@ async fn fail(
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/release", params(("job_id" = i64, Path)),
-    request_body(content = ReleaseRequest, description = "units as the job's scene records them"),
+    request_body(content = HeartbeatRequest, description = "a heartbeat's body: units as the job's scene records them, a checkpoint to resume from"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody),
         (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
