@@ -46,6 +46,13 @@ pub fn de(e: impl std::fmt::Display) -> String {
 /// Axes with linear coordinates on both sides, as most charts draw on.
 pub type Axes<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
+/// A chart over the coordinates that the ranges `X` and `Y` give (linear or log).
+pub type ChartOf<'a, DB, X, Y> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<<X as AsRangedCoord>::CoordDescType, <Y as AsRangedCoord>::CoordDescType>,
+>;
+
 /// A chart on `area` over `x` × `y` (linear or log coordinates) with the common caption size,
 /// margin and label areas.
 pub fn chart_on<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
@@ -53,7 +60,7 @@ pub fn chart_on<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
     caption: impl AsRef<str>,
     x: X,
     y: Y,
-) -> Result<ChartContext<'a, DB, Cartesian2d<X::CoordDescType, Y::CoordDescType>>, String> {
+) -> Result<ChartOf<'a, DB, X, Y>, String> {
     ChartBuilder::on(area)
         .caption(caption, (FONT, 22))
         .margin(15)
@@ -83,7 +90,7 @@ pub fn axes<'a, DB, X, Y>(
     caption: &str,
     (x, x_desc): (X, &str),
     (y, y_desc): (Y, &str),
-) -> Result<ChartContext<'a, DB, Cartesian2d<X::CoordDescType, Y::CoordDescType>>, String>
+) -> Result<ChartOf<'a, DB, X, Y>, String>
 where
     DB: DrawingBackend,
     X: AsRangedCoord,
