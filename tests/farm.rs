@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_farm::api::CampaignState;
 use grit_farm::{Client, ClientError, Secret};
 use serde_json::Value;
 use uuid::Uuid;
@@ -14,7 +14,8 @@ use uuid::Uuid;
 mod common;
 use common::results::{assert_bitwise_equal, grit_run, raw_series};
 use common::{
-    start_coordinator, start_worker, wait_for, Coordinator, GRIT, SERIAL, SUBMIT, WORKER,
+    grit_cli, start_coordinator, start_worker, submitter, wait_done, wait_for, Api, Coordinator,
+    GRIT, SERIAL, SUBMIT, WORKER,
 };
 
 /// The coarsest real scene at 60°.
@@ -39,28 +40,8 @@ fn worker(dir: &Path, url: &str, tag: &str) -> common::Proc {
     start_worker(dir, url, tag, &["--checkpoint-every", "1"])
 }
 
-fn submitter(url: &str) -> Client {
-    Client::new(url, Secret::new(Some(SUBMIT.into()))).unwrap()
-}
-
 fn worker_client(url: &str) -> Client {
     Client::new(url, Secret::new(Some(WORKER.into()))).unwrap()
-}
-
-/// Waits up to `limit` for the campaign to finish, which it must do as `done`.
-async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
-    let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
-    assert_eq!(s.state, CampaignState::Done);
-    s
-}
-
-fn grit_cli(url: &str, args: &[&str]) -> std::process::Output {
-    Command::new(GRIT)
-        .args(args)
-        .env("GRIT_COORDINATOR", url)
-        .env("GRIT_TOKEN", SUBMIT)
-        .output()
-        .expect("grit runs")
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -94,7 +75,7 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     assert_eq!(grit_run(dir.path(), &spec, "local", false), local);
     let other = dir.path().join("other.json");
     std::fs::write(&other, campaign(1, 2)).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_grit"))
+    let out = Command::new(GRIT)
         .args([
             "run",
             other.to_str().unwrap(),
@@ -163,15 +144,9 @@ async fn one_worker_process_holds_two_jobs_at_once() {
     let s = wait_done(&c, id, Duration::from_secs(120)).await;
     assert_eq!(s.impacts_done, 20);
     // Each job was run by its own loop of the one process, on its own lease.
-    let jobs: Value = reqwest::Client::new()
-        .get(format!("{}/api/v1/campaigns/{id}/jobs", coord.url))
-        .bearer_auth(SUBMIT)
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let jobs = Api::new(&coord.url)
+        .ok(&format!("/campaigns/{id}/jobs"))
+        .await;
     let mut names: Vec<&str> = jobs
         .as_array()
         .unwrap()
@@ -698,29 +673,13 @@ async fn sigterm_releases_the_job_with_a_checkpoint_and_exits_0() {
         |s| s.impacts_done >= 1,
     )
     .await;
-    let pid = w.child.id().to_string();
     // Twice, as under Slurm, which signals every process of a job while the job's batch shell
-    // passes its own SIGTERM on: the second must not cut the checkpoint short. The child is
-    // not reaped yet, so the second finds its pid even if it has exited.
+    // passes its own SIGTERM on: the second must not cut the checkpoint short.
     for _ in 0..2 {
-        assert!(Command::new("kill")
-            .args(["-TERM", &pid])
-            .status()
-            .unwrap()
-            .success());
+        w.signal("TERM");
         std::thread::sleep(Duration::from_millis(20));
     }
-    let start = Instant::now();
-    let code = loop {
-        if let Some(code) = w.child.try_wait().unwrap() {
-            break code;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "worker did not exit"
-        );
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let code = w.wait_exit();
     assert!(code.success(), "exit status {code:?}");
     assert!(
         w.log_text().contains("released with a checkpoint"),

@@ -12,24 +12,22 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use grit_erosion::{ImpactRecord, Sample};
-use grit_farm::api::{CampaignState, CampaignStatus, Checkpoint, HeartbeatRequest, ReleaseRequest};
+use grit_farm::api::{CampaignStatus, Checkpoint, HeartbeatRequest, ReleaseRequest};
 use grit_farm::{Client, Secret};
 use serde_json::json;
 use uuid::Uuid;
 
 mod common;
 use common::results::{assert_bitwise_equal, grit_run, raw_series};
-use common::{start_coordinator, start_worker, wait_for, Api, Proc, SERIAL, WORKER};
+use common::{
+    start_coordinator, start_worker, submitter, wait_done, wait_for, Api, Proc, SERIAL, WORKER,
+};
 
 type Series = Vec<(u64, u64, Vec<ImpactRecord>)>;
 
 /// The coarsest real scene at 60°.
 fn campaign(samples: u32, impacts: u32) -> String {
     common::campaign("faults", "[60]", samples, impacts)
-}
-
-fn submitter(url: &str) -> Client {
-    Client::new(url, Secret::new(Some(common::SUBMIT.into()))).unwrap()
 }
 
 /// A worker that uploads a checkpoint with every impact, with `extra` flags.
@@ -39,28 +37,10 @@ fn worker(dir: &Path, url: &str, name: &str, extra: &[&str]) -> Proc {
     start_worker(dir, url, name, &args)
 }
 
-/// Waits up to `limit` for the campaign to finish, which it must do as `done`.
-async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
-    let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
-    assert_eq!(s.state, CampaignState::Done, "{s:?}");
-    s
-}
-
 /// Waits up to `limit` until at least `n` impacts are stored.
 async fn wait_impacts(c: &Client, id: Uuid, n: u64, limit: Duration) -> CampaignStatus {
     let what = format!("{n} impacts");
     wait_for(limit, &what, || c.status(id), |s| s.impacts_done >= n).await
-}
-
-/// Sends `signal` (a `kill` name such as `STOP`) to `proc`.
-fn signal(proc: &Proc, signal: &str) {
-    let pid = proc.child.id().to_string();
-    let ok = Command::new("kill")
-        .args([&format!("-{signal}"), &pid])
-        .status()
-        .unwrap()
-        .success();
-    assert!(ok, "kill -{signal} {pid}");
 }
 
 /// Fails unless every worker process is still running.
@@ -165,9 +145,9 @@ async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit()
     let limit = Duration::from_secs(120);
     wait_impacts(&c, id, 1, limit).await;
 
-    signal(&coord.proc, "STOP");
+    coord.proc.signal("STOP");
     tokio::time::sleep(Duration::from_secs(5)).await;
-    signal(&coord.proc, "CONT");
+    coord.proc.signal("CONT");
     let s = c.status(id).await.unwrap();
     assert_eq!(s.jobs.leased, 1, "the job keeps its lease: {s:?}");
     let log = w.log_text();
@@ -186,9 +166,9 @@ async fn frozen_coordinator_keeps_workers_and_expired_leases_rerun_bit_for_bit()
         before.impacts_done < before.impacts_total,
         "the job must still be running when frozen again"
     );
-    signal(&coord.proc, "STOP");
+    coord.proc.signal("STOP");
     tokio::time::sleep(Duration::from_secs_f64(lease_s + 2.0)).await;
-    signal(&coord.proc, "CONT");
+    coord.proc.signal("CONT");
     let s = wait_done(&c, id, Duration::from_secs(180)).await;
     assert_eq!(s.impacts_done, impacts as u64);
     let log = w.log_text();

@@ -4,19 +4,21 @@
 //! and another killed with -9 leave a job that resumes, slice for slice, to the bits of an
 //! unbroken run.
 
-use std::path::Path;
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use grit_erosion::jet::JetSlice;
-use grit_farm::api::{CampaignState, CampaignStatus};
-use grit_farm::{Client, Secret};
+use grit_farm::api::CampaignStatus;
+use grit_farm::Client;
 use serde_json::Value;
 use uuid::Uuid;
 
 mod common;
 use common::results::{grit_run, raw_slices};
-use common::{start_coordinator, start_worker, wait_for, Api, GRIT, SERIAL, SUBMIT};
+use common::{
+    grit_cli, png_ok, start_coordinator, start_worker, submitter, succeeds, wait_for, Api, GRIT,
+    SERIAL, SUBMIT,
+};
 
 /// The lead's tiny scene (crates/grit-erosion/tests/jet.rs): 6 particles across a 0.6 mm jet
 /// on a 3 × 0.8 mm copper target, in slices of 1 µs, with `extra` fields.
@@ -29,29 +31,9 @@ fn spec(extra: &str) -> String {
     )
 }
 
-fn submitter(url: &str) -> Client {
-    Client::new(url, Secret::new(Some(SUBMIT.into()))).unwrap()
-}
-
-fn grit_cli(url: &str, args: &[&str]) -> std::process::Output {
-    Command::new(GRIT)
-        .args(args)
-        .env("GRIT_COORDINATOR", url)
-        .env("GRIT_TOKEN", SUBMIT)
-        .output()
-        .expect("grit runs")
-}
-
+/// Waits up to 3 minutes for campaign `id` to finish as `done`.
 async fn wait_done(c: &Client, id: Uuid) -> CampaignStatus {
-    let s = wait_for(
-        Duration::from_secs(180),
-        "done",
-        || c.status(id),
-        |s| s.state.is_final(),
-    )
-    .await;
-    assert_eq!(s.state, CampaignState::Done, "{s:?}");
-    s
+    common::wait_done(c, id, Duration::from_secs(180)).await
 }
 
 /// Bit-for-bit equality of two sets of slices (serde_json writes every f64 so it reads back
@@ -149,20 +131,12 @@ async fn a_jet_campaign_runs_on_the_farm_as_grit_run_runs_it() {
     let file = dir.path().join("results.json");
     std::fs::write(&file, serde_json::to_vec(&with_raw).unwrap()).unwrap();
     let charts = dir.path().join("charts");
-    let out = Command::new(GRIT)
-        .args([
-            "plot",
-            file.to_str().unwrap(),
-            "--out",
-            charts.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(Command::new(GRIT).args([
+        "plot",
+        file.to_str().unwrap(),
+        "--out",
+        charts.to_str().unwrap(),
+    ]));
     for stem in [
         "jet_profiles_c00_400_m_s",
         "jet_profiles_c01_500_m_s",
@@ -183,23 +157,8 @@ async fn a_jet_campaign_runs_on_the_farm_as_grit_run_runs_it() {
 
 /// Sends SIGTERM to `w` and waits for it to exit 0.
 fn terminate(w: &mut common::Proc) {
-    let pid = w.child.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
-    let start = Instant::now();
-    let code = loop {
-        if let Some(code) = w.child.try_wait().unwrap() {
-            break code;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "worker did not exit"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    w.signal("TERM");
+    let code = w.wait_exit();
     assert!(code.success(), "exit status {code:?}");
 }
 
@@ -266,11 +225,4 @@ async fn a_stopped_and_a_killed_worker_leave_a_jet_job_that_resumes_bit_for_bit(
     assert_eq!(farm[0].2.len(), total as usize);
     let local = raw_slices(&grit_run(dir.path(), &spec, "local", true));
     assert_same_bits(&farm, &local);
-}
-
-/// `path` is a PNG of more than a few colours.
-fn png_ok(path: &Path) {
-    let img = image::open(path).unwrap().to_rgb8();
-    let colours: std::collections::BTreeSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
-    assert!(colours.len() > 3, "{} is blank", path.display());
 }

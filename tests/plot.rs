@@ -10,6 +10,7 @@ use grit_erosion::{
     aggregate_campaign, CellInput, Impact, ImpactOutcome, ImpactRecord, SampleInput, Shape,
     SLOPE_WINDOW,
 };
+use grit_sph::lcg::Lcg;
 
 fn grit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_grit"))
@@ -111,18 +112,6 @@ fn plot_writes_every_chart_for_the_quick_results() {
     assert!(stdout.contains("wrote 10 files:"), "{stdout}");
 }
 
-/// Deterministic noise in [−1, 1] from a fixed LCG.
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-}
-
 /// A results file with raw series: three shapes at six angles, 3 samples of 30 impacts,
 /// eroding at the seed's modified-Oka rates with noise after 5 impacts of incubation.
 fn synthetic_results() -> serde_json::Value {
@@ -131,7 +120,9 @@ fn synthetic_results() -> serde_json::Value {
         reference: ShapeReference::HEXAGON,
         exponents: ShapeExponents::SEED,
     };
-    let mut rng = Lcg(7);
+    // Deterministic noise in [−1, 1].
+    let mut lcg = Lcg(7);
+    let mut noise = move || lcg.next_unit() * 2.0 - 1.0;
     let (mut cells, mut raw) = (Vec::new(), Vec::new());
     for shape in [Shape::Octagon, Shape::Hexagon, Shape::Square] {
         let (an, e) = shape.factors().unwrap();
@@ -141,15 +132,15 @@ fn synthetic_results() -> serde_json::Value {
             for sample in 0..3u32 {
                 let records: Vec<ImpactRecord> = (1..=30u32)
                     .map(|k| {
-                        let grain = 1.2e-4 * (1.0 + 0.05 * rng.next());
-                        let rate = model.erosion(angle, e, an) * (1.0 + 0.5 * rng.next());
+                        let grain = 1.2e-4 * (1.0 + 0.05 * noise());
+                        let rate = model.erosion(angle, e, an) * (1.0 + 0.5 * noise());
                         let loss = if k > 5 { grain * rate } else { 0.0 };
                         ImpactRecord {
                             impact: k,
                             grain_mass_kg: grain,
                             mass_loss_kg: loss,
-                            orientation_rad: rng.next(),
-                            aim_x_m: 1e-5 * rng.next(),
+                            orientation_rad: noise(),
+                            aim_x_m: 1e-5 * noise(),
                             outcome: ImpactOutcome {
                                 mass_loss_kg: loss,
                                 removed_particles: 0,

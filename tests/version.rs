@@ -3,16 +3,11 @@
 
 use std::process::Command;
 
+mod common;
+use common::{succeeds, GRIT};
+
 fn version() -> serde_json::Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_grit"))
-        .args(["version", "--json"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeeds(Command::new(GRIT).args(["version", "--json"]));
     serde_json::from_slice(&out.stdout).unwrap()
 }
 

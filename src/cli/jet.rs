@@ -12,7 +12,7 @@ use grit_sph::cracks::RockDamage;
 use grit_sph::crater::CraterSample;
 use serde::Serialize;
 
-use super::output::{check_writable, say, write_bytes, write_json};
+use super::output::{check_writable, say, write_bytes, ResultArgs};
 use super::{pool, progress};
 
 mod snapshots;
@@ -51,12 +51,8 @@ pub struct JetArgs {
     /// Worker threads of the engine (default: all cores).
     #[arg(long, value_parser = crate::cli::thread_count)]
     threads: Option<usize>,
-    /// Print the result as JSON on stdout.
-    #[arg(long)]
-    json: bool,
-    /// Also write the JSON result to this file.
-    #[arg(long, short)]
-    out: Option<PathBuf>,
+    #[command(flatten)]
+    result: ResultArgs,
     /// Write pictures (PNG: phase, pressure, damage) and ParaView files (VTU, PVD) of the scene
     /// at the end of every `--snapshot-every`-th slice into this folder.
     #[arg(long, value_name = "DIR")]
@@ -138,7 +134,7 @@ impl JetArgs {
 
 /// Runs one jet with a progress bar over simulated time and prints its crater series.
 pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
-    for (flag, path) in [("--out", &a.out), ("--checkpoint", &a.checkpoint)] {
+    for (flag, path) in [("--out", &a.result.out), ("--checkpoint", &a.checkpoint)] {
         if let Some(path) = path {
             check_writable(flag, path)?;
         }
@@ -165,7 +161,7 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
     let pool = pool(a.threads)?;
     // The bar counts simulated microseconds.
     let total_us = (params.time_ms * 1e3).ceil() as u64;
-    let bar = progress::bar(total_us, "µs simulated", !a.json);
+    let bar = progress::bar(total_us, "µs simulated", !a.result.json);
     bar.set_position(
         run.slices()
             .last()
@@ -194,7 +190,7 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
             s.grains
         );
         // Without a terminal (a log file) the bar is hidden: a line per slice instead.
-        if bar.is_hidden() && !a.json {
+        if bar.is_hidden() && !a.result.json {
             eprintln!(
                 "slice {}/{}: t = {:.1} µs, {msg}, {:.1} s",
                 s.slice,
@@ -227,10 +223,8 @@ pub fn jet(a: JetArgs) -> anyhow::Result<ExitCode> {
         wall_s: t0.elapsed().as_secs_f64(),
         error: failure.as_ref().map(|e| e.to_string()),
     };
-    if let Some(path) = &a.out {
-        write_json(path, &out)?;
-    }
-    if a.json {
+    a.result.write(&out)?;
+    if a.result.json {
         say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         say!(

@@ -1,11 +1,32 @@
-//! What commands write: standard output that tolerates a closed pipe, and JSON and CSV files
-//! written whole or not at all.
+//! What commands write: standard output that tolerates a closed pipe, one run's result as JSON,
+//! and JSON and CSV files written whole or not at all.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Context};
+
+/// Where one run's result goes besides its table: JSON on stdout instead, and a JSON file.
+#[derive(clap::Args)]
+pub struct ResultArgs {
+    /// Print the result as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the JSON result, with every impact or slice in detail, to this file.
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+}
+
+impl ResultArgs {
+    /// Writes `result` to the `--out` file, when one is given.
+    pub fn write(&self, result: &impl serde::Serialize) -> anyhow::Result<()> {
+        match &self.out {
+            Some(path) => write_json(path, result),
+            None => Ok(()),
+        }
+    }
+}
 
 /// `println!` that ignores a closed stdout (`grit status --json | head`) instead of panicking.
 macro_rules! say {

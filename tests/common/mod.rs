@@ -1,15 +1,18 @@
 //! Helpers the process-level tests share: the `grit` binary as coordinator and workers, each a
 //! child process killed on drop with its log in a file; the coarsest real campaign; a JSON
-//! client of the API; and polling until a campaign gets somewhere.
+//! client of the API; the CLI as a submitter; and polling until a campaign gets somewhere.
 #![allow(dead_code)] // each test file uses its own subset
 
 use std::future::Future;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use grit_farm::api::{CampaignState, CampaignStatus};
+use grit_farm::{Client, Secret};
 use serde_json::Value;
+use uuid::Uuid;
 
 pub mod results;
 
@@ -55,6 +58,34 @@ impl Proc {
     pub fn kill9(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
+    }
+
+    /// Sends `signal` (a `kill` name such as `TERM` or `STOP`). The child is not reaped before
+    /// `wait_exit`, so its pid is still its own even if it has exited.
+    pub fn signal(&self, signal: &str) {
+        let pid = self.child.id().to_string();
+        let ok = Command::new("kill")
+            .args([&format!("-{signal}"), &pid])
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok, "kill -{signal} {pid}");
+    }
+
+    /// Waits up to 30 s for the process to exit; how it exited.
+    pub fn wait_exit(&mut self) -> ExitStatus {
+        let start = Instant::now();
+        loop {
+            if let Some(code) = self.child.try_wait().unwrap() {
+                return code;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(30),
+                "{} did not exit",
+                self.log.display()
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
     }
 }
 
@@ -181,6 +212,40 @@ pub fn start_worker(dir: &Path, url: &str, name: &str, args: &[&str]) -> Proc {
         .spawn()
         .expect("grit work starts");
     Proc { child, log }
+}
+
+/// Runs `cmd` to its end, which must succeed (its standard error is the failure's message).
+pub fn succeeds(cmd: &mut Command) -> Output {
+    let out = cmd.output().expect("the command starts");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// `grit` with `args` as a submitter of the coordinator at `url` (its address and token from
+/// the environment, as a user's shell gives them).
+pub fn grit_cli(url: &str, args: &[&str]) -> Output {
+    Command::new(GRIT)
+        .args(args)
+        .env("GRIT_COORDINATOR", url)
+        .env("GRIT_TOKEN", SUBMIT)
+        .output()
+        .expect("grit runs")
+}
+
+/// A client of the coordinator at `url` with the submit token.
+pub fn submitter(url: &str) -> Client {
+    Client::new(url, Secret::new(Some(SUBMIT.into()))).unwrap()
+}
+
+/// Waits up to `limit` for campaign `id` to finish, which it must do as `done`.
+pub async fn wait_done(c: &Client, id: Uuid, limit: Duration) -> CampaignStatus {
+    let s = wait_for(limit, "done", || c.status(id), |s| s.state.is_final()).await;
+    assert_eq!(s.state, CampaignState::Done, "{s:?}");
+    s
 }
 
 /// Polls `status` every 100 ms until `done` accepts its answer, which it returns; fails after

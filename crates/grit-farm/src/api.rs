@@ -508,20 +508,9 @@ pub struct FailRequest {
     pub units: Vec<Value>,
 }
 
-/// Release: give the job back without counting an attempt (a worker shutting down).
-#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ReleaseRequest {
-    /// The lease id from the claim.
-    pub lease_id: Uuid,
-    /// Units not yet acknowledged (also read as `impacts` and `slices`).
-    #[serde(default, alias = "impacts", alias = "slices")]
-    #[schema(value_type = Vec<Object>)]
-    pub units: Vec<Value>,
-    /// A checkpoint to resume from.
-    #[serde(default)]
-    pub checkpoint: Option<Checkpoint>,
-}
+/// Release: give the job back without counting an attempt (a worker shutting down). Its body
+/// is a heartbeat's: the units not yet acknowledged and a checkpoint to resume from.
+pub type ReleaseRequest = HeartbeatRequest;
 
 /// Records as the JSON values a worker's requests carry (every f64 kept to the bit).
 pub fn units<R: Serialize>(records: &[R]) -> Vec<Value> {

@@ -248,8 +248,16 @@ mod tests {
         assert_eq!(back.checkpoint(), run.checkpoint());
         let scenes = crate::scenes::SceneRegistry::default();
         let jet = scenes.get("jet").unwrap();
+        let stored = |scene: &str, params: String, seed| crate::db::StoredJob {
+            id: 7,
+            scene: scene.into(),
+            params,
+            seed,
+        };
         let p_json = serde_json::to_string(&p).unwrap();
-        let kept = jet.verify_upload(&c, 7, &p_json, 5).unwrap();
+        let kept = jet
+            .verify_upload(&c, &stored("jet", p_json.clone(), 5))
+            .unwrap();
         assert_eq!(kept.bytes, run.checkpoint());
         let e = verify::<JetRun>(&c, 7, &p, 6).unwrap_err();
         assert_eq!(e.field, "checkpoint.data_b64");
@@ -266,10 +274,12 @@ mod tests {
         assert_eq!(e.rule, "is 1 but the checkpoint holds 0 slices");
         // An impact checkpoint is no jet checkpoint, and the other way round.
         let (ip, ic, _) = good();
-        assert!(jet.verify_upload(&ic, 7, &p_json, 3).is_err());
+        assert!(jet.verify_upload(&ic, &stored("jet", p_json, 3)).is_err());
         let ip_json = serde_json::to_string(&ip).unwrap();
         let impact = scenes.get("impact").unwrap();
-        assert!(impact.verify_upload(&c, 7, &ip_json, 5).is_err());
+        assert!(impact
+            .verify_upload(&c, &stored("impact", ip_json, 5))
+            .is_err());
     }
 
     #[test]

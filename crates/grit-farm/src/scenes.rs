@@ -14,7 +14,7 @@ use serde_json::Value;
 
 use crate::api::Checkpoint;
 use crate::checkpoint::{verify_upload, CheckpointBytes, CheckpointError};
-use crate::db::Reported;
+use crate::db::{self, Reported};
 use crate::error::{Error, Result};
 
 /// What the coordinator does with one scene's jobs, its type erased.
@@ -22,14 +22,12 @@ pub trait FarmScene: Send + Sync {
     /// Reported `units` (JSON values) as the scene's records; a unit that is not one is a 422
     /// naming `units[i]…`.
     fn decode(&self, units: Vec<Value>) -> Result<Reported>;
-    /// [`verify_upload`] of checkpoint `c` as job `job_id`'s, whose stored parameters are
-    /// `params` (JSON) and seed `seed`: the checked bytes for the store.
+    /// [`verify_upload`] of checkpoint `c` as the stored `job`'s, against its parameters and
+    /// seed: the checked bytes for the store.
     fn verify_upload(
         &self,
         c: &Checkpoint,
-        job_id: i64,
-        params: &str,
-        seed: u64,
+        job: &db::StoredJob,
     ) -> std::result::Result<CheckpointBytes, CheckpointError>;
     /// [`Scene::results`] of a campaign whose spec is `spec`, its records as stored (JSON).
     fn results(
@@ -104,15 +102,13 @@ impl<S: Scene> FarmScene for Ops<S> {
     fn verify_upload(
         &self,
         c: &Checkpoint,
-        job_id: i64,
-        params: &str,
-        seed: u64,
+        job: &db::StoredJob,
     ) -> std::result::Result<CheckpointBytes, CheckpointError> {
-        let params: S::Params = serde_json::from_str(params).map_err(|e| CheckpointError {
+        let params: S::Params = serde_json::from_str(&job.params).map_err(|e| CheckpointError {
             field: "checkpoint",
             rule: format!("the job's stored parameters do not read: {e}"),
         })?;
-        verify_upload::<S>(c, job_id, &params, seed).map(|(_, bytes)| bytes)
+        verify_upload::<S>(c, job.id, &params, job.seed).map(|(_, bytes)| bytes)
     }
 
     fn results(

@@ -232,7 +232,6 @@ async fn a_scene_the_farm_does_not_name_runs_on_it() {
             job.job_id,
             job.lease_id,
             Reported::of::<Drip>(&[bad]).unwrap(),
-            None,
         )
         .await
         .unwrap_err();

@@ -7,15 +7,14 @@ use std::ops::Range;
 
 use grit_erosion::impact::aggregate::cumulative_series;
 use grit_erosion::{CampaignResults, CellResult, Impact};
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::analysis::{series_label, Analysis, Series, HV_GPA};
 use crate::draw::{
-    colour, de, error_bar, file_safe, marker_style, save, steady_notes, top, with_notes,
-    DrawResult, Figure, FONT,
+    chart_on, colour, de, draw_mesh, error_bar, file_safe, line_key, marker_style, save,
+    steady_notes, top, with_notes, Axes, DrawResult, Figure, FONT,
 };
 use crate::{PlotError, PlotInput, RawSeries, Report};
 
@@ -59,25 +58,6 @@ where
         .map_err(de)
 }
 
-/// The axes every chart of this module draws on.
-type Axes<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
-
-/// Axes over `x` × `y` with the common caption size, margin and label areas.
-fn axes<'a, DB: DrawingBackend>(
-    area: &'a DrawingArea<DB, Shift>,
-    caption: impl AsRef<str>,
-    x: Range<f64>,
-    y: Range<f64>,
-) -> Result<Axes<'a, DB>, String> {
-    ChartBuilder::on(area)
-        .caption(caption, (FONT, 22))
-        .margin(15)
-        .x_label_area_size(55)
-        .y_label_area_size(85)
-        .build_cartesian_2d(x, y)
-        .map_err(de)
-}
-
 /// Axes of cumulative surface mass loss against cumulative grain mass, from 0.
 fn mass_axes<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -85,15 +65,13 @@ fn mass_axes<DB: DrawingBackend>(
     xmax: f64,
     ymax: f64,
 ) -> Result<Axes<'_, DB>, String> {
-    let mut chart = axes(area, caption, 0.0..xmax, 0.0..ymax)?;
-    chart
-        .configure_mesh()
-        .x_desc("cumulative grain mass (g per m of depth)")
-        .y_desc("cumulative surface mass loss (mg per m of depth)")
-        .label_style((FONT, 14))
-        .axis_desc_style((FONT, 17))
-        .draw()
-        .map_err(de)?;
+    let mut chart = chart_on(area, caption, 0.0..xmax, 0.0..ymax)?;
+    draw_mesh(
+        chart
+            .configure_mesh()
+            .x_desc("cumulative grain mass (g per m of depth)")
+            .y_desc("cumulative surface mass loss (mg per m of depth)"),
+    )?;
     Ok(chart)
 }
 
@@ -104,22 +82,16 @@ fn angle_axes<'a, DB: DrawingBackend>(
     y: Range<f64>,
     y_desc: &str,
 ) -> Result<Axes<'a, DB>, String> {
-    let mut chart = axes(area, caption, 0.0..95.0, y)?;
-    chart
-        .configure_mesh()
-        .x_desc("impact angle α (degrees from the surface)")
-        .x_labels(20)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_desc(y_desc)
-        .label_style((FONT, 14))
-        .axis_desc_style((FONT, 17))
-        .draw()
-        .map_err(de)?;
+    let mut chart = chart_on(area, caption, 0.0..95.0, y)?;
+    draw_mesh(
+        chart
+            .configure_mesh()
+            .x_desc("impact angle α (degrees from the surface)")
+            .x_labels(20)
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_desc(y_desc),
+    )?;
     Ok(chart)
-}
-
-fn line_key(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], style)
 }
 
 fn dash_key(
@@ -900,29 +872,27 @@ impl Figure for Convergence<'_> {
             .max()
             .unwrap_or(1);
         let (ymin, ymax) = (bottom(values()), top(values()));
-        let mut chart = axes(
+        let mut chart = chart_on(
             &area,
             "Convergence of erosion with the number of samples",
             0.5..(nmax as f64 + 0.5),
             ymin..ymax,
         )?;
-        chart
-            .configure_mesh()
-            .x_desc("number of samples k (the first k with a slope)")
-            .y_desc(EROSION_AXIS)
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 17))
-            .x_labels((nmax + 1).min(26))
-            // Sample counts are whole numbers: ticks between them stay blank.
-            .x_label_formatter(&|v| {
-                if (v - v.round()).abs() < 1e-9 {
-                    format!("{v:.0}")
-                } else {
-                    String::new()
-                }
-            })
-            .draw()
-            .map_err(de)?;
+        draw_mesh(
+            chart
+                .configure_mesh()
+                .x_desc("number of samples k (the first k with a slope)")
+                .y_desc(EROSION_AXIS)
+                .x_labels((nmax + 1).min(26))
+                // Sample counts are whole numbers: ticks between them stay blank.
+                .x_label_formatter(&|v| {
+                    if (v - v.round()).abs() < 1e-9 {
+                        format!("{v:.0}")
+                    } else {
+                        String::new()
+                    }
+                }),
+        )?;
         for (i, c) in cells().enumerate() {
             let col = colour(i);
             let bar = col.mix(0.5).stroke_width(1);

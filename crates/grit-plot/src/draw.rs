@@ -1,8 +1,11 @@
-//! Drawing shared by the charts: one figure drawn on both backends, a strip of notes under
-//! the plot, colours, error bars and axis ranges.
+//! Drawing shared by the charts: one figure drawn on both backends, the charts' axes and legend
+//! keys, a strip of notes under the plot, colours, error bars and axis ranges.
 
 use std::path::{Path, PathBuf};
 
+use plotters::chart::MeshStyle;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -38,6 +41,71 @@ pub type DrawResult = Result<(), String>;
 /// Turns any plotters error into text.
 pub fn de(e: impl std::fmt::Display) -> String {
     e.to_string()
+}
+
+/// Axes with linear coordinates on both sides, as most charts draw on.
+pub type Axes<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A chart over the coordinates that the ranges `X` and `Y` give (linear or log).
+pub type ChartOf<'a, DB, X, Y> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<<X as AsRangedCoord>::CoordDescType, <Y as AsRangedCoord>::CoordDescType>,
+>;
+
+/// A chart on `area` over `x` × `y` (linear or log coordinates) with the common caption size,
+/// margin and label areas.
+pub fn chart_on<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: impl AsRef<str>,
+    x: X,
+    y: Y,
+) -> Result<ChartOf<'a, DB, X, Y>, String> {
+    ChartBuilder::on(area)
+        .caption(caption, (FONT, 22))
+        .margin(15)
+        .x_label_area_size(55)
+        .y_label_area_size(85)
+        .build_cartesian_2d(x, y)
+        .map_err(de)
+}
+
+/// Draws `mesh`, its descriptions and labels set by the chart, in the common fonts.
+pub fn draw_mesh<DB, X, Y>(mesh: &mut MeshStyle<'_, '_, X, Y, DB>) -> DrawResult
+where
+    DB: DrawingBackend,
+    X: Ranged + ValueFormatter<X::ValueType>,
+    Y: Ranged + ValueFormatter<Y::ValueType>,
+{
+    mesh.label_style((FONT, 14))
+        .axis_desc_style((FONT, 17))
+        .draw()
+        .map_err(de)
+}
+
+/// A chart as [`chart_on`] makes it, its mesh drawn and its axes described by `x_desc` and
+/// `y_desc`.
+pub fn axes<'a, DB, X, Y>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    (x, x_desc): (X, &str),
+    (y, y_desc): (Y, &str),
+) -> Result<ChartOf<'a, DB, X, Y>, String>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord,
+    Y: AsRangedCoord,
+    X::CoordDescType: ValueFormatter<X::Value>,
+    Y::CoordDescType: ValueFormatter<Y::Value>,
+{
+    let mut chart = chart_on(area, caption, x, y)?;
+    draw_mesh(chart.configure_mesh().x_desc(x_desc).y_desc(y_desc))?;
+    Ok(chart)
+}
+
+/// A legend key of a line drawn in `style`.
+pub fn line_key(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], style)
 }
 
 /// A chart that can be drawn on any backend.

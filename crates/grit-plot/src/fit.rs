@@ -12,9 +12,8 @@ use plotters::prelude::*;
 
 use crate::charts::legend_box;
 use crate::draw::{
-    colour, de, error_bar, prepare_output, save, with_notes, DrawResult, Figure, FONT,
+    axes, colour, de, error_bar, prepare_output, save, with_notes, DrawResult, Figure,
 };
-use crate::jet::axes;
 use crate::{PlotError, Report};
 
 /// kg per kg to mg per g.
@@ -142,21 +141,9 @@ impl Figure for FitChart<'_> {
         match self.sweep {
             Sweep::Speed => {
                 let ymin = values.iter().cloned().fold(f64::INFINITY, f64::min) / 1.3;
-                let mut chart = ChartBuilder::on(&area)
-                    .caption(caption, (FONT, 22))
-                    .margin(15)
-                    .x_label_area_size(55)
-                    .y_label_area_size(85)
-                    .build_cartesian_2d((lo..hi).log_scale(), (ymin..ymax).log_scale())
-                    .map_err(de)?;
-                chart
-                    .configure_mesh()
-                    .x_desc(x_desc)
-                    .y_desc(y_desc)
-                    .label_style((FONT, 14))
-                    .axis_desc_style((FONT, 17))
-                    .draw()
-                    .map_err(de)?;
+                let x = ((lo..hi).log_scale(), x_desc);
+                let y = ((ymin..ymax).log_scale(), y_desc);
+                let mut chart = axes(&area, caption, x, y)?;
                 self.draw_groups(&mut chart, &groups, &curve)?;
                 legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
             }

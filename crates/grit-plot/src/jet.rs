@@ -10,13 +10,12 @@ use std::ops::Range;
 use std::path::Path;
 
 use grit_erosion::jet::aggregate::{JetCampaignResults, JetCellResult, JetMeanPoint};
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::draw::{
-    colour, de, error_bar, file_safe, marker_style, prepare_output, save, with_notes, DrawResult,
-    Figure, FONT,
+    axes, colour, de, error_bar, file_safe, line_key, marker_style, prepare_output, save,
+    with_notes, DrawResult, Figure,
 };
 use crate::{PlotError, Report};
 
@@ -26,37 +25,6 @@ const UM_PER_M: f64 = 1e6;
 const US_PER_S: f64 = 1e6;
 /// kg to mg.
 const MG_PER_KG: f64 = 1e6;
-
-type Axes<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
-
-/// Axes over `x` × `y` described by `x_desc`, `y_desc`, in the style of the impact charts.
-pub(crate) fn axes<'a, DB: DrawingBackend>(
-    area: &'a DrawingArea<DB, Shift>,
-    caption: &str,
-    (x, x_desc): (Range<f64>, &str),
-    (y, y_desc): (Range<f64>, &str),
-) -> Result<Axes<'a, DB>, String> {
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, (FONT, 22))
-        .margin(15)
-        .x_label_area_size(55)
-        .y_label_area_size(85)
-        .build_cartesian_2d(x, y)
-        .map_err(de)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .label_style((FONT, 14))
-        .axis_desc_style((FONT, 17))
-        .draw()
-        .map_err(de)?;
-    Ok(chart)
-}
-
-fn line_key(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], style)
-}
 
 /// A range around `values` with 8 % padding on each side (a unit span when they are all
 /// equal, ±1 when there are none).

@@ -13,10 +13,9 @@ use plotters::prelude::*;
 
 use crate::charts::legend_box;
 use crate::draw::{
-    colour, de, error_bar, marker_style, prepare_output, save, steady_notes, top, with_notes,
+    axes, colour, de, error_bar, marker_style, prepare_output, save, steady_notes, top, with_notes,
     DrawResult, Figure,
 };
-use crate::jet::axes;
 use crate::{PlotError, Report};
 
 /// kg per kg to mg per g.

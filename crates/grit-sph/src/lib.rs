@@ -24,6 +24,7 @@ pub mod crater;
 pub mod dem;
 pub mod geometry;
 pub mod kernel;
+pub mod lcg;
 pub mod math;
 pub mod neighbours;
 pub mod particles;

@@ -484,6 +484,19 @@ impl Default for Material {
 }
 
 #[cfg(test)]
+impl Material {
+    /// The Johnson–Cook strength and fracture laws of a preset that has both.
+    pub(crate) fn johnson_cook_laws(&self) -> (&JohnsonCook, &JohnsonCookDamage) {
+        let jc = self.plasticity.as_ref().and_then(Strength::johnson_cook);
+        let d = self.damage.as_ref().and_then(Fracture::johnson_cook);
+        (
+            jc.expect("Johnson–Cook strength"),
+            d.expect("Johnson–Cook fracture"),
+        )
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -495,17 +508,12 @@ mod tests {
             m.validate().unwrap();
         }
         let cu = Material::copper();
-        let jc = cu
-            .plasticity
-            .as_ref()
-            .and_then(Strength::johnson_cook)
-            .unwrap();
+        let (jc, d) = cu.johnson_cook_laws();
         assert_eq!(
             (jc.a_pa, jc.b_pa, jc.n, jc.c, jc.m),
             (90e6, 292e6, 0.31, 0.025, 1.09)
         );
         assert_eq!((jc.ref_strain_rate_s, jc.t_melt_k), (1.0, 1356.0));
-        let d = cu.damage.as_ref().and_then(Fracture::johnson_cook).unwrap();
         assert_eq!(
             (d.d1, d.d2, d.d3, d.d4, d.d5),
             (0.54, 4.89, -3.03, 0.014, 1.12)
@@ -519,17 +527,12 @@ mod tests {
         );
 
         let al = Material::al6061();
-        let jc = al
-            .plasticity
-            .as_ref()
-            .and_then(Strength::johnson_cook)
-            .unwrap();
+        let (jc, d) = al.johnson_cook_laws();
         assert_eq!(
             (jc.a_pa, jc.b_pa, jc.n, jc.c, jc.m),
             (324e6, 114e6, 0.42, 0.002, 1.34)
         );
         assert_eq!(jc.t_melt_k, 933.0);
-        let d = al.damage.as_ref().and_then(Fracture::johnson_cook).unwrap();
         assert_eq!(
             (d.d1, d.d2, d.d3, d.d4, d.d5),
             (-0.77, 1.45, -0.47, 0.0, 1.6)

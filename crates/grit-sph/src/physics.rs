@@ -210,23 +210,18 @@ pub fn fracture_strain(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{Fracture, Material, Strength};
+    use crate::material::Material;
 
     #[test]
     fn radial_return_lands_on_the_yield_surface() {
         let m = Material::aisi304();
-        let jc = m
-            .plasticity
-            .as_ref()
-            .and_then(Strength::johnson_cook)
-            .unwrap()
-            .clone();
+        let (jc, _) = m.johnson_cook_laws();
         let g = m.shear_modulus();
         let s = Matrix::new(3e9, 1e9, 1e9, -1e9);
         let dt = 1e-9;
-        let r = radial_return(s, g, &jc, 0.1, dt, 400.0);
+        let r = radial_return(s, g, jc, 0.1, dt, 400.0);
         assert!(r.d_eps > 0.0);
-        let (sy, _, _) = jc_yield(&jc, 0.1 + r.d_eps, r.d_eps / dt, 400.0);
+        let (sy, _, _) = jc_yield(jc, 0.1 + r.d_eps, r.d_eps / dt, 400.0);
         assert!(
             (von_mises(&r.sdev) - sy).abs() < 1e-6 * sy,
             "{} vs {sy}",
@@ -239,14 +234,9 @@ mod tests {
     #[test]
     fn elastic_state_is_untouched() {
         let m = Material::aisi304();
-        let jc = m
-            .plasticity
-            .as_ref()
-            .and_then(Strength::johnson_cook)
-            .unwrap()
-            .clone();
+        let (jc, _) = m.johnson_cook_laws();
         let s = Matrix::new(1e8, 0.0, 0.0, -1e8);
-        let r = radial_return(s, m.shear_modulus(), &jc, 0.0, 1e-9, 293.0);
+        let r = radial_return(s, m.shear_modulus(), jc, 0.0, 1e-9, 293.0);
         assert_eq!(r.d_eps, 0.0);
         assert_eq!(r.sdev, s);
     }
@@ -254,11 +244,7 @@ mod tests {
     #[test]
     fn yield_is_zero_at_melt_and_rate_term_never_softens() {
         let m = Material::aisi304();
-        let jc = m
-            .plasticity
-            .as_ref()
-            .and_then(Strength::johnson_cook)
-            .unwrap();
+        let (jc, _) = m.johnson_cook_laws();
         assert_eq!(jc_yield(jc, 0.2, 1e3, jc.t_melt_k + 10.0).0, 0.0);
         let slow = jc_yield(jc, 0.0, 1e-8, 293.0).0;
         assert_eq!(slow, jc.a_pa);
@@ -267,12 +253,7 @@ mod tests {
     #[test]
     fn fracture_strain_follows_triaxiality() {
         let m = Material::aisi304();
-        let d = m.damage.as_ref().and_then(Fracture::johnson_cook).unwrap();
-        let jc = m
-            .plasticity
-            .as_ref()
-            .and_then(Strength::johnson_cook)
-            .unwrap();
+        let (jc, d) = m.johnson_cook_laws();
         let comp = fracture_strain(d, jc, -1.0, 1.0, 293.0);
         let tens = fracture_strain(d, jc, 1.0, 1.0, 293.0);
         assert!(

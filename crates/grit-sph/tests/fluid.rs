@@ -97,55 +97,22 @@ fn the_time_step_is_the_fluid_s_cfl_limit() {
 fn bad_fluid_input_names_its_field() {
     let mut w = World::new(Settings::default()).unwrap();
     let pts = [Vector::zeros(), Vector::new(1e-5, 0.0)];
-    let err = |r: Result<usize, grit_sph::InputError>| r.unwrap_err().field;
     let water = Fluid::water;
-    assert_eq!(
-        err(w.add_fluid("w", water(), &pts, &[1e-10], &[0.0, 0.0], Vector::zeros())),
-        "w.volume_m2"
-    );
-    assert_eq!(
-        err(w.add_fluid("w", water(), &pts, &[1e-10; 2], &[0.0], Vector::zeros())),
-        "w.pressure_pa"
-    );
-    assert_eq!(
-        err(w.add_fluid(
-            "w",
-            water(),
-            &pts,
-            &[1e-10, -1.0],
-            &[0.0, 0.0],
-            Vector::zeros()
-        )),
-        "w.volume_m2[1]"
-    );
-    assert_eq!(
-        err(w.add_fluid(
-            "w",
-            water(),
-            &pts,
-            &[1e-10; 2],
-            &[0.0, -2e5],
-            Vector::zeros()
-        )),
-        "w.pressure_pa[1]"
-    );
-    assert_eq!(
-        err(w.add_fluid(
-            "w",
-            water(),
-            &pts,
-            &[1e-10; 2],
-            &[f64::NAN, 0.0],
-            Vector::zeros()
-        )),
-        "w.pressure_pa[0]"
-    );
+    let cases: [(&[f64], &[f64], &str); 5] = [
+        (&[1e-10], &[0.0; 2], "w.volume_m2"),
+        (&[1e-10; 2], &[0.0], "w.pressure_pa"),
+        (&[1e-10, -1.0], &[0.0; 2], "w.volume_m2[1]"),
+        (&[1e-10; 2], &[0.0, -2e5], "w.pressure_pa[1]"),
+        (&[1e-10; 2], &[f64::NAN, 0.0], "w.pressure_pa[0]"),
+    ];
+    for (volumes, pressures, field) in cases {
+        let r = w.add_fluid("w", water(), &pts, volumes, pressures, Vector::zeros());
+        assert_eq!(r.unwrap_err().field, field);
+    }
     let mut bad = water();
     bad.dynamic_viscosity_pa_s = -1.0;
-    assert_eq!(
-        err(w.add_fluid("w", bad, &pts, &[1e-10; 2], &[0.0; 2], Vector::zeros())),
-        "w.fluid.dynamic_viscosity_pa_s"
-    );
+    let r = w.add_fluid("w", bad, &pts, &[1e-10; 2], &[0.0; 2], Vector::zeros());
+    assert_eq!(r.unwrap_err().field, "w.fluid.dynamic_viscosity_pa_s");
     assert!(w.bodies().is_empty());
     // A fluid may start empty, for an inflow to fill.
     let mut fed = World::new(w.settings().clone()).unwrap();

@@ -20,7 +20,7 @@ use serde::Serialize;
 pub use scene::SceneArgs;
 use snapshots::Snapshots;
 
-use super::output::{check_writable, say, write_json};
+use super::output::{check_writable, say, ResultArgs};
 use super::{pool, progress};
 
 /// Arguments of `grit sample`.
@@ -37,12 +37,8 @@ pub struct SampleArgs {
     /// Worker threads of the engine (default: all cores).
     #[arg(long, value_parser = crate::cli::thread_count)]
     threads: Option<usize>,
-    /// Print the result as JSON on stdout.
-    #[arg(long)]
-    json: bool,
-    /// Also write the JSON result (with every impact's details) to this file.
-    #[arg(long, short)]
-    out: Option<PathBuf>,
+    #[command(flatten)]
+    result: ResultArgs,
     /// Go on from a checkpoint file (a job's saved surface, e.g. taken from the farm's
     /// database) with the parameters and seed stored in it; `--impacts` is then the total.
     #[arg(long)]
@@ -85,7 +81,7 @@ struct SampleOutput<'a> {
 
 /// Runs one sample locally with a progress bar and prints its mass-loss series.
 pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
-    if let Some(path) = &a.out {
+    if let Some(path) = &a.result.out {
         check_writable("--out", path)?;
     }
     let mut s = match &a.resume {
@@ -170,10 +166,8 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
         impacts: s.records(),
         error,
     };
-    if let Some(path) = &a.out {
-        write_json(path, &out)?;
-    }
-    if a.json {
+    a.result.write(&out)?;
+    if a.result.json {
         #[derive(Serialize)]
         struct Short<'a> {
             series: &'a [Point],

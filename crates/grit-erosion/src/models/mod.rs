@@ -9,17 +9,10 @@ pub mod fit;
 pub mod oka;
 pub mod shapes;
 
-/// Deterministic noise in [−1, 1] from a fixed LCG seeded `seed`, so the fits' noisy tests
+/// Deterministic noise in [−1, 1] from an LCG seeded `seed`, so the fits' noisy tests
 /// never flake.
 #[cfg(test)]
 pub(crate) fn test_noise(n: usize, seed: u64) -> Vec<f64> {
-    let mut s: u64 = 0x9e37_79b9_7f4a_7c15 ^ seed;
-    (0..n)
-        .map(|_| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        })
-        .collect()
+    let mut lcg = grit_sph::lcg::Lcg(0x9e37_79b9_7f4a_7c15 ^ seed);
+    (0..n).map(|_| lcg.next_unit() * 2.0 - 1.0).collect()
 }

@@ -9,6 +9,8 @@ use crate::error::{Error, Result};
 
 /// A job's scene as stored.
 pub struct StoredJob {
+    /// The job's id.
+    pub id: i64,
     /// `campaigns.scene`: the scene's kind.
     pub scene: String,
     /// `cells.params`: the scene's parameters as JSON.
@@ -31,6 +33,7 @@ impl Store {
         .await?
         .ok_or_else(|| Error::NotFound(format!("job {job_id}")))?;
         Ok(StoredJob {
+            id: job_id,
             scene: r.get(0),
             params: r.get(1),
             seed: r.get::<i64, _>(2) as u64,

@@ -47,7 +47,7 @@ async fn run_one(s: &Store, loss: impl Fn(u32, u32) -> f64) -> ClaimedJob {
         .map(|k| record(&j, k, loss(j.sample, k)))
         .collect();
     let ckpt = j.extendable.then(|| checkpoint(&j));
-    s.complete(j.job_id, j.lease_id, imp(&recs), ckpt)
+    s.complete(j.job_id, j.lease_id, imp(&recs).with_checkpoint(ckpt))
         .await
         .unwrap();
     j
@@ -202,14 +202,18 @@ async fn a_repeated_complete_grows_nothing_twice() {
     let j = run_one(&s, |_, _| 0.0).await;
     // The worker did not hear the answer and sends the same complete again.
     let e = s
-        .complete(j.job_id, j.lease_id, imp(&[]), Some(checkpoint(&j)))
+        .complete(
+            j.job_id,
+            j.lease_id,
+            imp(&[]).with_checkpoint(Some(checkpoint(&j))),
+        )
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
     let st = s.status(id).await.unwrap();
     assert_eq!((st.jobs.queued, st.impacts_total), (1, 25));
     let e = s
-        .complete(j.job_id, Uuid::new_v4(), imp(&[]), None)
+        .complete(j.job_id, Uuid::new_v4(), imp(&[]))
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
@@ -236,7 +240,7 @@ async fn settle_cost() {
         let recs: Vec<ImpactRecord> = (1..=400).map(|k| record(&j, k, 0.0)).collect();
         let ckpt = Some(checkpoint(&j));
         let t = std::time::Instant::now();
-        s.complete(j.job_id, j.lease_id, imp(&recs), ckpt)
+        s.complete(j.job_id, j.lease_id, imp(&recs).with_checkpoint(ckpt))
             .await
             .unwrap();
         took.push(t.elapsed().as_secs_f64() * 1e3);

@@ -35,9 +35,9 @@ async fn a_refused_request_in_a_group_leaves_nothing_and_fails_no_other() {
     // are applied in one group, in this order.
     let (gap, stale, good, claimed) = tokio::join!(
         // Impact 1 comes before the gap: nothing of the refused heartbeat may stay.
-        s.heartbeat(a.job_id, a.lease_id, imp(&with_gap), None),
-        s.heartbeat(b.job_id, Uuid::new_v4(), imp(&one), None),
-        s.complete(b.job_id, b.lease_id, imp(&both), None),
+        s.heartbeat(a.job_id, a.lease_id, imp(&with_gap)),
+        s.heartbeat(b.job_id, Uuid::new_v4(), imp(&one)),
+        s.complete(b.job_id, b.lease_id, imp(&both)),
         s.claim("c"),
     );
     assert_eq!(gap.unwrap_err().status(), StatusCode::UNPROCESSABLE_ENTITY);
@@ -53,7 +53,7 @@ async fn a_refused_request_in_a_group_leaves_nothing_and_fails_no_other() {
         .unwrap();
     assert_eq!(stored, 0, "nothing of the refused heartbeat stays");
     let late = s
-        .heartbeat(b.job_id, b.lease_id, imp(&[]), None)
+        .heartbeat(b.job_id, b.lease_id, imp(&[]))
         .await
         .unwrap_err();
     assert_eq!(

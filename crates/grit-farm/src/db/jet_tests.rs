@@ -72,7 +72,7 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
     let beat = |recs: Vec<JetSlice>| {
         let s = &s;
         let j = &j;
-        async move { s.heartbeat(j.job_id, j.lease_id, slices(&recs), None).await }
+        async move { s.heartbeat(j.job_id, j.lease_id, slices(&recs)).await }
     };
     assert_eq!(beat(vec![slice(1)]).await.unwrap().impacts_done, 1);
     assert_eq!(
@@ -103,14 +103,12 @@ async fn jet_jobs_store_slices_in_order_and_nothing_else() {
         "units[0].sample.mass_loss_kg_m"
     );
     let impacts = s
-        .heartbeat(j.job_id, j.lease_id, imp(&[placeholder()]), None)
+        .heartbeat(j.job_id, j.lease_id, imp(&[placeholder()]))
         .await;
     assert_eq!(field(impacts.unwrap_err()), "units");
-    let early = s
-        .complete(j.job_id, j.lease_id, Reported::none(), None)
-        .await;
+    let early = s.complete(j.job_id, j.lease_id, Reported::none()).await;
     assert_eq!(field(early.unwrap_err()), "units");
-    s.complete(j.job_id, j.lease_id, slices(&[slice(3)]), None)
+    s.complete(j.job_id, j.lease_id, slices(&[slice(3)]))
         .await
         .unwrap();
     let status = s.status(created.id).await.unwrap();
@@ -149,7 +147,7 @@ async fn an_impact_job_takes_no_slices() {
         "{wire}"
     );
     let e = s
-        .heartbeat(j.job_id, j.lease_id, slices(&[slice(1)]), None)
+        .heartbeat(j.job_id, j.lease_id, slices(&[slice(1)]))
         .await
         .unwrap_err();
     assert_eq!(field(e), "units");

@@ -79,7 +79,7 @@ async fn grown_cells_results_keep_their_bytes() {
         let ckpt = j
             .extendable
             .then(|| crate::checkpoint::CheckpointBytes::new(j.impacts_planned, vec![0; 3]));
-        s.complete(j.job_id, j.lease_id, imp(&recs), ckpt)
+        s.complete(j.job_id, j.lease_id, imp(&recs).with_checkpoint(ckpt))
             .await
             .unwrap();
     }

@@ -55,9 +55,7 @@ async fn workers_are_listed_idle_or_with_the_job_they_hold() {
     let id = s.create_campaign(&spec, None).await.unwrap().id;
     let j = s.claim("busy").await.unwrap().unwrap();
     tokio::time::sleep(Duration::from_millis(5)).await;
-    s.heartbeat(j.job_id, j.lease_id, imp(&[]), None)
-        .await
-        .unwrap();
+    s.heartbeat(j.job_id, j.lease_id, imp(&[])).await.unwrap();
     let w = s.workers(Duration::from_secs(60)).await.unwrap();
     let names: Vec<&str> = w.workers.iter().map(|w| w.name.as_str()).collect();
     assert_eq!(names, ["busy", "idle"], "most recently seen first");
@@ -88,7 +86,7 @@ async fn failure_reports_keep_the_error_and_stale_leases_get_409() {
     let id = s.create_campaign(&spec, None).await.unwrap().id;
     let j = s.claim("w").await.unwrap().unwrap();
     let e = s
-        .heartbeat(j.job_id, Uuid::new_v4(), imp(&[]), None)
+        .heartbeat(j.job_id, Uuid::new_v4(), imp(&[]))
         .await
         .unwrap_err();
     assert_eq!(e.status(), axum::http::StatusCode::CONFLICT);
@@ -223,15 +221,12 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
         .heartbeat(
             j.job_id,
             j.lease_id,
-            imp(&records[..350]),
-            Some(CheckpointBytes::new(350, bytes.clone())),
+            imp(&records[..350]).with_checkpoint(Some(CheckpointBytes::new(350, bytes.clone()))),
         )
         .await
         .unwrap();
     assert_eq!(beat.impacts_done, 350);
-    s.release(j.job_id, j.lease_id, imp(&[]), None)
-        .await
-        .unwrap();
+    s.release(j.job_id, j.lease_id, imp(&[])).await.unwrap();
     let again = s.claim("w").await.unwrap().unwrap();
     assert_eq!(again.impacts_done, 350);
     assert_eq!(
@@ -239,7 +234,7 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
         serde_json::to_value(Some(Checkpoint::from_bytes(j.job_id, 350, &bytes))).unwrap()
     );
     // Impacts already stored are skipped.
-    s.complete(again.job_id, again.lease_id, imp(&records[300..]), None)
+    s.complete(again.job_id, again.lease_id, imp(&records[300..]))
         .await
         .unwrap();
     let stored: Vec<(String, f64)> =
@@ -283,7 +278,7 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
         let s = &s;
         let j = &j;
         async move {
-            match s.heartbeat(j.job_id, j.lease_id, imp(&[rec]), None).await {
+            match s.heartbeat(j.job_id, j.lease_id, imp(&[rec])).await {
                 Err(Error::Invalid { field, .. }) => field,
                 other => panic!("expected a 422, got {other:?}"),
             }
@@ -318,7 +313,6 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
             j.job_id,
             j.lease_id,
             imp(&[placeholder_record(1, grain, surface)]),
-            None,
         )
         .await
         .unwrap();

@@ -116,24 +116,41 @@ pub(super) struct NewUnits {
 }
 
 /// What a lease holder reports with a write: the records of the units it finished, of its
-/// job's scene, ready for the store.
-pub struct Reported(pub(super) NewUnits);
+/// job's scene, ready for the store, and the checkpoint after them when it sends one.
+pub struct Reported {
+    units: NewUnits,
+    checkpoint: Option<CheckpointBytes>,
+}
 
 impl Reported {
-    /// `records` of scene `S`.
+    /// `records` of scene `S`, without a checkpoint.
     pub fn of<S: Scene>(records: &[S::Record]) -> Result<Reported> {
-        NewUnits::of::<S>(records).map(Reported)
+        let units = NewUnits::of::<S>(records)?;
+        Ok(Reported {
+            units,
+            checkpoint: None,
+        })
     }
 
-    /// A report without units.
+    /// A report without units or checkpoint.
     pub fn none() -> Reported {
-        Reported(NewUnits {
+        let units = NewUnits {
             kind: "",
             unit: "unit",
             rows: Vec::new(),
             masses: Vec::new(),
             check: Box::new(NoUnits),
-        })
+        };
+        Reported {
+            units,
+            checkpoint: None,
+        }
+    }
+
+    /// This report with `checkpoint` (checked by the caller:
+    /// `crate::checkpoint::verify_upload`) as the state after its units.
+    pub fn with_checkpoint(self, checkpoint: Option<CheckpointBytes>) -> Reported {
+        Reported { checkpoint, ..self }
     }
 }
 
@@ -278,20 +295,18 @@ impl Store {
         }))
     }
 
-    /// Renews the lease, stores the finished units and an optional
-    /// checkpoint (checked by the caller: `crate::checkpoint::verify_upload`).
+    /// Renews the lease, stores the finished units and the checkpoint if one is reported.
     pub async fn heartbeat(
         &self,
         job_id: i64,
         lease: Uuid,
         reported: Reported,
-        checkpoint: Option<CheckpointBytes>,
     ) -> Result<HeartbeatResponse> {
         let op = Op::Heartbeat {
             job_id,
             lease,
-            units: reported.0,
-            checkpoint,
+            units: reported.units,
+            checkpoint: reported.checkpoint,
         };
         match self.group.apply(op).await? {
             Reply::Beat(r) => Ok(r),
@@ -302,24 +317,19 @@ impl Store {
     /// Stores the last units and marks the job done; it must then have every planned unit.
     /// The checkpoint after the last unit is kept when the job's cell may still grow, and a
     /// cell whose last job this was is assessed and grown in the same transaction.
-    pub async fn complete(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        reported: Reported,
-        checkpoint: Option<CheckpointBytes>,
-    ) -> Result<()> {
+    pub async fn complete(&self, job_id: i64, lease: Uuid, reported: Reported) -> Result<()> {
         let op = Op::Complete {
             job_id,
             lease,
-            units: reported.0,
-            checkpoint,
+            units: reported.units,
+            checkpoint: reported.checkpoint,
             scenes: self.scenes.clone(),
         };
         self.group.apply(op).await.map(drop)
     }
 
-    /// Records a failure: back to the queue, or `failed` once attempts reach the maximum.
+    /// Records a failure: back to the queue, or `failed` once attempts reach the maximum. The
+    /// report's units are stored; a failed run's checkpoint is not kept.
     pub async fn fail(
         &self,
         job_id: i64,
@@ -331,24 +341,18 @@ impl Store {
             job_id,
             lease,
             error: error.chars().take(MAX_ERROR_CHARS).collect(),
-            units: reported.0,
+            units: reported.units,
         };
         self.group.apply(op).await.map(drop)
     }
 
     /// Gives a job back without counting an attempt, keeping its units and checkpoint.
-    pub async fn release(
-        &self,
-        job_id: i64,
-        lease: Uuid,
-        reported: Reported,
-        checkpoint: Option<CheckpointBytes>,
-    ) -> Result<()> {
+    pub async fn release(&self, job_id: i64, lease: Uuid, reported: Reported) -> Result<()> {
         let op = Op::Release {
             job_id,
             lease,
-            units: reported.0,
-            checkpoint,
+            units: reported.units,
+            checkpoint: reported.checkpoint,
         };
         self.group.apply(op).await.map(drop)
     }

@@ -18,7 +18,6 @@ use uuid::Uuid;
 
 use super::AppState;
 use crate::api::*;
-use crate::checkpoint::CheckpointBytes;
 use crate::db::Reported;
 use crate::error::{Error, Result};
 
@@ -42,34 +41,28 @@ impl Report {
     /// units decoded as its records (a 422 naming `units[i]…` for one that is not), the
     /// checkpoint verified (`crate::checkpoint::verify_upload`) as the job's own. One read of
     /// the job serves both; 404 for an unknown job.
-    async fn checked(
-        &mut self,
-        s: &AppState,
-        job: i64,
-    ) -> Result<(Reported, Option<CheckpointBytes>)> {
+    async fn checked(&mut self, s: &AppState, job: i64) -> Result<Reported> {
         let units = std::mem::take(&mut self.units);
         let checkpoint = self.checkpoint.take();
         if units.is_empty() && checkpoint.is_none() {
-            return Ok((Reported::none(), None));
+            return Ok(Reported::none());
         }
         let stored = s.store.stored_job(job).await?;
         let scene = s.store.scenes.get(&stored.scene)?;
         let reported = scene.decode(units)?;
         let Some(c) = checkpoint else {
-            return Ok((reported, None));
+            return Ok(reported);
         };
         // Decoding a checkpoint of a large surface or a jet's world takes milliseconds: off
         // the async threads.
-        let checked = tokio::task::spawn_blocking(move || {
-            scene.verify_upload(&c, job, &stored.params, stored.seed)
-        })
-        .await
-        .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
+        let checked = tokio::task::spawn_blocking(move || scene.verify_upload(&c, &stored))
+            .await
+            .map_err(|e| Error::Internal(format!("checkpoint check panicked: {e}")))?;
         let bytes = checked.map_err(|e| {
             tracing::warn!(job, error = %e, "checkpoint refused; nothing of the request stored");
             Error::invalid(e.field, e.rule)
         })?;
-        Ok((reported, Some(bytes)))
+        Ok(reported.with_checkpoint(Some(bytes)))
     }
 
     /// A heartbeat, complete or release body for job `raw` (which takes no `error`): the job
@@ -79,13 +72,13 @@ impl Report {
         s: &AppState,
         raw: &str,
         endpoint: &str,
-    ) -> Result<(i64, Uuid, Reported, Option<CheckpointBytes>)> {
+    ) -> Result<(i64, Uuid, Reported)> {
         let job = job_id(raw)?;
         if self.error.is_some() {
             return Err(Report::refuse("error", endpoint));
         }
-        let (units, checkpoint) = self.checked(s, job).await?;
-        Ok((job, self.lease_id, units, checkpoint))
+        let reported = self.checked(s, job).await?;
+        Ok((job, self.lease_id, reported))
     }
 
     /// The 422 for a field the endpoint does not take.
@@ -108,7 +101,7 @@ pub fn router() -> Router<AppState> {
 #[derive(utoipa::OpenApi)]
 #[openapi(
     paths(claim, heartbeat, complete, fail, release),
-    components(schemas(HeartbeatRequest, CompleteRequest, FailRequest, ReleaseRequest))
+    components(schemas(HeartbeatRequest, CompleteRequest, FailRequest))
 )]
 pub struct Doc;
 
@@ -243,10 +236,8 @@ async fn heartbeat(
     Path(job): Path<String>,
     ApiJson(req): ApiJson<Report>,
 ) -> Result<Json<HeartbeatResponse>> {
-    let (job, lease, units, checkpoint) = req.without_error(&s, &job, "heartbeat").await?;
-    Ok(Json(
-        s.store.heartbeat(job, lease, units, checkpoint).await?,
-    ))
+    let (job, lease, reported) = req.without_error(&s, &job, "heartbeat").await?;
+    Ok(Json(s.store.heartbeat(job, lease, reported).await?))
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/complete", params(("job_id" = i64, Path)),
@@ -259,8 +250,8 @@ async fn complete(
     Path(job): Path<String>,
     ApiJson(req): ApiJson<Report>,
 ) -> Result<StatusCode> {
-    let (job, lease, units, checkpoint) = req.without_error(&s, &job, "complete").await?;
-    s.store.complete(job, lease, units, checkpoint).await?;
+    let (job, lease, reported) = req.without_error(&s, &job, "complete").await?;
+    s.store.complete(job, lease, reported).await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
@@ -284,13 +275,13 @@ async fn fail(
         ));
     };
     let error = error.to_string();
-    let (units, _) = req.checked(&s, job).await?;
-    s.store.fail(job, req.lease_id, &error, units).await?;
+    let reported = req.checked(&s, job).await?;
+    s.store.fail(job, req.lease_id, &error, reported).await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
 #[utoipa::path(post, path = "/api/v1/worker/jobs/{job_id}/release", params(("job_id" = i64, Path)),
-    request_body(content = ReleaseRequest, description = "units as the job's scene records them"),
+    request_body(content = HeartbeatRequest, description = "a heartbeat's body: units as the job's scene records them, a checkpoint to resume from"),
     responses((status = 204), (status = 401), (status = 404, body = ErrorBody), (status = 409, body = ErrorBody), (status = 410, body = ErrorBody),
         (status = 422, body = ErrorBody, description = CHECKPOINT_422)),
     security(("worker_token" = [])))]
@@ -299,7 +290,7 @@ async fn release(
     Path(job): Path<String>,
     ApiJson(req): ApiJson<Report>,
 ) -> Result<StatusCode> {
-    let (job, lease, units, checkpoint) = req.without_error(&s, &job, "release").await?;
-    s.store.release(job, lease, units, checkpoint).await?;
+    let (job, lease, reported) = req.without_error(&s, &job, "release").await?;
+    s.store.release(job, lease, reported).await?;
     Ok(StatusCode::NO_CONTENT)
 }

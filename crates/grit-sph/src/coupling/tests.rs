@@ -1,4 +1,5 @@
 use super::*;
+use crate::lcg::Lcg;
 
 /// Garnet-like abrasive of the AWJ paper: d = 0.2 mm, ρ 4120 kg/m³.
 const D: f64 = 0.2e-3;
@@ -21,18 +22,6 @@ fn block(n: usize) -> Vec<Vector> {
         }
     }
     out
-}
-
-/// A small deterministic generator for scattered test values in [0, 1).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[test]
@@ -266,16 +255,16 @@ fn scattered() -> (
     let mut rng = Lcg(7);
     let mut pos = block(40);
     for x in &mut pos {
-        *x += Vector::new(rng.next() - 0.5, rng.next() - 0.5) * (0.3 * DX);
+        *x += Vector::new(rng.next_unit() - 0.5, rng.next_unit() - 0.5) * (0.3 * DX);
     }
     let n = pos.len();
     let vel: Vec<Vector> = (0..n)
-        .map(|_| Vector::new(200.0 * rng.next(), -400.0 - 100.0 * rng.next()))
+        .map(|_| Vector::new(200.0 * rng.next_unit(), -400.0 - 100.0 * rng.next_unit()))
         .collect();
-    let rho_bar: Vec<f64> = (0..n).map(|_| 950.0 + 100.0 * rng.next()).collect();
+    let rho_bar: Vec<f64> = (0..n).map(|_| 950.0 + 100.0 * rng.next_unit()).collect();
     let mass = vec![1000.0 * DX * DX; n];
     let theta: Vec<Vector> = (0..n)
-        .map(|_| Vector::new(1e6 * (rng.next() - 0.5), 1e7 * (rng.next() - 0.5)))
+        .map(|_| Vector::new(1e6 * (rng.next_unit() - 0.5), 1e7 * (rng.next_unit() - 0.5)))
         .collect();
     let grains = vec![
         grain(1.0e-3, 1.0e-3, 10.0, -300.0),

@@ -217,31 +217,17 @@ mod tests {
             .unwrap()
             .force_on_particle;
         assert!((h.y / (0.5 * expect) - 1.0).abs() < 1e-12);
+        let sliding = |speed| {
+            let v = Vector::new(speed, 0.0);
+            penalty_force(x_p, v, m_p, &g, d_ini, law(0.0, 0.3), dt)
+                .unwrap()
+                .force_on_particle
+        };
         // Sliding fast along +x: friction along −x, capped at μ F^n.
-        let s = penalty_force(
-            x_p,
-            Vector::new(1e4, 0.0),
-            m_p,
-            &g,
-            d_ini,
-            law(0.0, 0.3),
-            dt,
-        )
-        .unwrap()
-        .force_on_particle;
+        let s = sliding(1e4);
         assert!((s.x / (-0.3 * expect) - 1.0).abs() < 1e-12, "{s:?}");
         // Slow sliding: the force that stops it in half a step, below the cap.
-        let s = penalty_force(
-            x_p,
-            Vector::new(1e-3, 0.0),
-            m_p,
-            &g,
-            d_ini,
-            law(0.0, 0.3),
-            dt,
-        )
-        .unwrap()
-        .force_on_particle;
+        let s = sliding(1e-3);
         assert!((s.x / (-2.0 * m_p / dt * 1e-3) - 1.0).abs() < 1e-12);
         // A spinning grain drags a resting particle along its surface: ω > 0 moves the top
         // point towards −x.

@@ -2,6 +2,7 @@
 //! momentum, the Coulomb cap and the slide-to-roll transition.
 
 use super::*;
+use crate::lcg::Lcg;
 
 const G: f64 = 9.81;
 
@@ -142,13 +143,8 @@ fn coulomb_cap_then_rolling_at_five_sevenths() {
 #[test]
 fn many_grains_conserve_momentum_and_lose_energy_deterministically() {
     // A loose cloud on a lattice with pseudo-random velocities, no walls, no gravity.
-    let mut state = 12345u64;
-    let mut rand = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
+    let mut lcg = Lcg(12345);
+    let mut rand = move || lcg.next_unit() - 0.5;
     let mut grains = Vec::new();
     for k in 0..36 {
         let (ix, iy) = ((k % 6) as f64, (k / 6) as f64);

@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::pairs::{pairs_of, PairCache};
-use super::{BodyConst, ParTasks, SphView, StepCtx};
+use super::{accel_and_theta, BodyConst, ParTasks, SphView, StepCtx};
 use crate::eos::MieGruneisen;
 use crate::fluid::{self, ArtificialViscosity, Fluid};
 use crate::math::Vector;
@@ -161,9 +161,7 @@ pub(crate) fn fluid_accelerations(
     let fc = |i: usize| bc[p.body[i] as usize].fluid;
     theta.clear();
     theta.resize(p.len(), Vector::zeros());
-    accel
-        .par_iter_mut()
-        .zip(theta.par_iter_mut())
+    accel_and_theta(accel, theta)
         .par_tasks()
         .enumerate()
         .for_each(|(i, (acc, th))| {

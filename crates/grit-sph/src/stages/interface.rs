@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use super::{BodyConst, ParTasks, SphView, StepCtx};
+use super::{accel_and_theta, BodyConst, ParTasks, SphView, StepCtx};
 use crate::fluid::{self, ArtificialViscosity};
 use crate::math::Vector;
 use crate::neighbours::NeighbourLists;
@@ -88,9 +88,7 @@ pub(crate) fn interface_forces(
     let (s, cross, solid_viscosity) = (ctx.sph(), ctx.cross, ctx.settings.solid_viscosity);
     let SphView { p, k, bc, .. } = s;
     let h = k.h;
-    accel
-        .par_iter_mut()
-        .zip(theta.par_iter_mut())
+    accel_and_theta(accel, theta)
         .par_tasks()
         .enumerate()
         .for_each(|(i, (acc, th))| {

@@ -48,6 +48,7 @@ use crate::eos::EquationOfState;
 use crate::jh2::{self, Jh2Laws};
 use crate::kernel::Kernel;
 use crate::material::Material;
+use crate::math::Vector;
 use crate::neighbours::{HalfIndex, NeighbourLists};
 use crate::particles::Particles;
 use crate::world::Settings;
@@ -84,6 +85,15 @@ pub(crate) trait ParTasks: IndexedParallelIterator {
 }
 
 impl<I: IndexedParallelIterator> ParTasks for I {}
+
+/// Each particle's acceleration beside its θ, for the loops that add to both in one pass.
+pub(crate) fn accel_and_theta<'a>(
+    accel: &'a mut [Vector],
+    theta: &'a mut [Vector],
+) -> impl IndexedParallelIterator<Item = (&'a mut Vector, &'a mut Vector)> {
+    use rayon::prelude::*;
+    accel.par_iter_mut().zip(theta.par_iter_mut())
+}
 
 /// Particle volumes V_i = m_i/ρ_i into `out`, taken once per particle so that no sum over pairs
 /// divides for its neighbour's volume.

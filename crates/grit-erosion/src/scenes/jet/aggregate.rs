@@ -670,35 +670,10 @@ pub fn aggregate_jet_campaign(
 
 #[cfg(test)]
 mod tests {
-    use grit_sph::crater::CraterSample;
     use proptest::prelude::*;
 
     use super::*;
-
-    /// Slice `k` (from 1) of a sample at `t_s` with mass loss `loss` and crater `cd`.
-    fn slice(k: u32, t_s: f64, loss: f64, cd: f64) -> JetSlice {
-        JetSlice {
-            slice: k,
-            sample: CraterSample {
-                t_s,
-                mass_loss_kg_m: loss,
-                crater_depth_m: cd,
-                crater_width_m: 2.0 * cd,
-                max_plastic_strain: 0.1,
-            },
-            half_depth_width_m: cd,
-            profile: vec![[-1e-3, -cd], [0.0, -2.0 * cd], [1e-3, -cd]],
-            steps: 10,
-            particles: 100,
-            grains: 1,
-            grains_fed: k as u64,
-            water_deleted_kg_m: 0.0,
-            water_fed_kg_m: 0.0,
-            wall_s: 0.5,
-            grain_hits: None,
-            rock: None,
-        }
-    }
+    use crate::jet::test_slice as slice;
 
     /// A sample of `n` slices of `dt` s losing `rate` kg/m/s after slice `onset` (from 1),
     /// plus `wiggle(k)`.

@@ -107,9 +107,8 @@ pub fn cells_from_runs(runs: &[JetRunRecord]) -> Result<Vec<JetCellInput>, Aggre
 
 #[cfg(test)]
 mod tests {
-    use grit_sph::crater::CraterSample;
-
     use super::*;
+    use crate::jet::test_slice;
 
     fn run(velocity: f64, seed: u64, material: &str) -> JetRunRecord {
         let mut params = JetParams {
@@ -120,27 +119,7 @@ mod tests {
         };
         params.material.0 = grit_sph::Material::by_name(material).unwrap();
         let slices = (1..=2)
-            .map(|k| JetSlice {
-                slice: k,
-                sample: CraterSample {
-                    t_s: k as f64 * 1e-6,
-                    mass_loss_kg_m: seed as f64 * 1e-6,
-                    crater_depth_m: 1e-5 * k as f64,
-                    crater_width_m: 1e-4,
-                    max_plastic_strain: 0.1,
-                },
-                half_depth_width_m: 5e-5,
-                profile: vec![[0.0, 0.0]],
-                steps: 1,
-                particles: 1,
-                grains: 0,
-                grains_fed: 0,
-                water_deleted_kg_m: 0.0,
-                water_fed_kg_m: 0.0,
-                wall_s: 0.1,
-                grain_hits: None,
-                rock: None,
-            })
+            .map(|k| test_slice(k, k as f64 * 1e-6, seed as f64 * 1e-6, 1e-5 * k as f64))
             .collect();
         JetRunRecord {
             params,
