@@ -172,10 +172,12 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     let spec = AnySpec::from_json(&text)
         .and_then(|s| s.validate().map(|_| s))
         .with_context(|| a.campaign.display().to_string())?;
-    let out = match (
-        embedded::engine_mismatch(&spec, &a.out).await?,
-        &a.engine_upgrade,
-    ) {
+    // Without --engine-upgrade, `embedded::run` itself refuses a folder of another engine.
+    let mismatch = match &a.engine_upgrade {
+        Some(_) => embedded::engine_mismatch(&spec, &a.out).await?,
+        None => None,
+    };
+    let out = match (mismatch, &a.engine_upgrade) {
         (Some((pinned, own)), Some(fresh)) => {
             eprintln!(
                 "--engine-upgrade: {} holds this campaign on engine {pinned}; running it afresh in {} on engine {own}",

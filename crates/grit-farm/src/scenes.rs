@@ -51,20 +51,17 @@ fn record<S: Scene>(text: &str) -> Result<S::Record> {
     serde_json::from_str(text).map_err(|e| Error::Internal(format!("stored unit record: {e}")))
 }
 
+/// Stored records (JSON) as scene `S`'s, in their order.
+fn records<S: Scene>(texts: &[String]) -> Result<Vec<S::Record>> {
+    texts.iter().map(|t| record::<S>(t)).collect()
+}
+
 /// A stored cell's records (JSON) as scene `S`'s.
 fn cell_records<S: Scene>(c: CellRecords<String>) -> Result<CellRecords<S::Record>> {
     let samples = c
         .samples
         .into_iter()
-        .map(|(sample, texts)| {
-            Ok((
-                sample,
-                texts
-                    .iter()
-                    .map(|t| record::<S>(t))
-                    .collect::<Result<_>>()?,
-            ))
-        })
+        .map(|(sample, texts)| Ok((sample, records::<S>(&texts)?)))
         .collect::<Result<_>>()?;
     Ok(CellRecords {
         cell: c.cell,
@@ -126,11 +123,7 @@ impl<S: Scene> FarmScene for Ops<S> {
                 jobs.into_iter()
                     .map(|j| {
                         Ok(StoredJob {
-                            records: j
-                                .records
-                                .iter()
-                                .map(|t| record::<S>(t))
-                                .collect::<Result<_>>()?,
+                            records: records::<S>(&j.records)?,
                             cell: j.cell,
                             sample: j.sample,
                             seed: j.seed,

@@ -32,6 +32,7 @@ pub use any::{AnySpec, CampaignPlan, PlannedCell};
 pub use plan::{
     annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
 };
+pub(crate) use stored::stored_error;
 pub use stored::{results_json, CellRecords, StoredCell, StoredJob, UnitMasses};
 
 /// Fewest impacts a sample may be planned with: the slope window (20) plus one.

@@ -77,6 +77,12 @@ pub struct StoredJob<R> {
     pub records: Vec<R>,
 }
 
+/// The error of a stored part (`what`: the spec, a cell's scene, the aggregation) that does
+/// not read back.
+pub(crate) fn stored_error(what: &str, e: impl std::fmt::Display) -> SceneError {
+    SceneError::Run(format!("{what}: {e}"))
+}
+
 /// A job of scene `S` written with its records under [`Scene::RECORDS`].
 struct RawJob<'a, S: Scene>(&'a StoredJob<S::Record>);
 

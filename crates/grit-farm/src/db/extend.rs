@@ -83,8 +83,8 @@ struct Seeded {
 }
 
 /// After a job of cell `plan`, one with growth rules, completed: once every job of the cell
-/// is done, grows the cell as its scene decides or finishes it. Runs inside the completing transaction, so a crash anywhere
-/// leaves either the job still leased or the cell fully grown.
+/// is done, grows the cell as its scene decides or finishes it. Runs inside the completing
+/// transaction, so a crash anywhere leaves either the job still leased or the cell fully grown.
 pub(super) async fn settle_cell(
     tx: &mut Transaction<'static, Sqlite>,
     scene: &dyn FarmScene,

@@ -4,7 +4,9 @@
 
 use std::collections::BTreeMap;
 
-use crate::campaign::{annotate, next_step, results_json, CellRecords, NextStep, StoredJob};
+use crate::campaign::{
+    annotate, next_step, results_json, stored_error, CellRecords, NextStep, StoredJob,
+};
 use crate::campaign::{StoredCell, UnitMasses};
 use crate::impact::aggregate::{aggregate_campaign, aggregate_cell, CellInput, Impact};
 use crate::impact::aggregate::{SampleInput, SLOPE_WINDOW};
@@ -48,10 +50,6 @@ where
         .collect()
 }
 
-fn stored(what: &str, e: impl std::fmt::Display) -> SceneError {
-    SceneError::Run(format!("{what}: {e}"))
-}
-
 /// [`crate::Scene::results`] of the impact scene.
 pub(crate) fn results(
     spec: &str,
@@ -68,14 +66,14 @@ pub(crate) fn results(
     // The stored spec is the parsed one written back, every default filled in, so a reader
     // of the results can rerun exactly this campaign.
     let spec: serde_json::Value =
-        serde_json::from_str(spec).map_err(|e| stored("stored spec", e))?;
+        serde_json::from_str(spec).map_err(|e| stored_error("stored spec", e))?;
     let mut results = aggregate_campaign(&inputs, SLOPE_WINDOW)
-        .map_err(|e| stored("aggregation", e))?
+        .map_err(|e| stored_error("aggregation", e))?
         .with_spec(spec);
     // The cells' stored scenes, not today's defaults, say how the impacts ran.
     if let Some(c) = cells.first() {
-        let p: ImpactParams =
-            serde_json::from_str(&c.cell.params).map_err(|e| stored("stored cell scene", e))?;
+        let p: ImpactParams = serde_json::from_str(&c.cell.params)
+            .map_err(|e| stored_error("stored cell scene", e))?;
         results.numerics = Some(p.numerics);
     }
     for (result, c) in results.cells.iter_mut().zip(&cells) {
@@ -91,6 +89,6 @@ pub(crate) fn grow(
 ) -> Result<NextStep, SceneError> {
     let units = units.iter().map(|(&s, m)| (s, m.iter().copied()));
     let result = aggregate_cell(&input(cell, samples(units)), SLOPE_WINDOW)
-        .map_err(|e| stored(&format!("assessing cell {}", cell.index), e))?;
+        .map_err(|e| stored_error(&format!("assessing cell {}", cell.index), e))?;
     Ok(next_step(&result, cell.until_steady, cell.target_sem))
 }

@@ -3,12 +3,8 @@
 
 use super::aggregate::{aggregate_jet_campaign, JetCellInput, JetSampleInput};
 use super::{JetParams, JetRun, JetSlice};
-use crate::campaign::{results_json, CellRecords, JetCampaignSpec, StoredJob};
+use crate::campaign::{results_json, stored_error, CellRecords, JetCampaignSpec, StoredJob};
 use crate::SceneError;
-
-fn stored(what: &str, e: impl std::fmt::Display) -> SceneError {
-    SceneError::Run(format!("{what}: {e}"))
-}
 
 /// [`crate::Scene::results`] of the jet scene.
 pub(crate) fn results(
@@ -16,7 +12,7 @@ pub(crate) fn results(
     cells: Vec<CellRecords<JetSlice>>,
     raw: Option<Vec<StoredJob<JetSlice>>>,
 ) -> Result<String, SceneError> {
-    let spec = JetCampaignSpec::from_json(spec_text).map_err(|e| stored("stored spec", e))?;
+    let spec = JetCampaignSpec::from_json(spec_text).map_err(|e| stored_error("stored spec", e))?;
     // A cell keeps no pump pressure of its own: a swept one is among its swept values, a
     // single one the spec's.
     let pressure = spec
@@ -26,8 +22,8 @@ pub(crate) fn results(
     let inputs = cells
         .into_iter()
         .map(|c| {
-            let params: JetParams =
-                serde_json::from_str(&c.cell.params).map_err(|e| stored("stored cell scene", e))?;
+            let params: JetParams = serde_json::from_str(&c.cell.params)
+                .map_err(|e| stored_error("stored cell scene", e))?;
             Ok(JetCellInput {
                 cell: c.cell.index,
                 params,
@@ -45,9 +41,9 @@ pub(crate) fn results(
         })
         .collect::<Result<Vec<_>, SceneError>>()?;
     let spec: serde_json::Value =
-        serde_json::from_str(spec_text).map_err(|e| stored("stored spec", e))?;
+        serde_json::from_str(spec_text).map_err(|e| stored_error("stored spec", e))?;
     let results = aggregate_jet_campaign(&inputs)
-        .map_err(|e| stored("aggregation", e))?
+        .map_err(|e| stored_error("aggregation", e))?
         .with_spec(spec);
     results_json::<JetRun, _>(&results, raw.as_deref())
 }
