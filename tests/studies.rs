@@ -151,10 +151,38 @@ fn sweep_runs_two_variants_resumes_and_charts() {
 }
 
 #[test]
+fn the_budget_study_charges_each_impact_and_groups_by_angle() {
+    let stdout = ok(&grit(&[
+        "study",
+        "budget",
+        "--angle",
+        "60",
+        "--spacing-m",
+        COARSE,
+        "--seeds",
+        "1,2",
+        "--impacts",
+        "2",
+        "--patch",
+        r#"{"friction": 0.3}"#,
+        "--json",
+    ]));
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4, "two samples of two impacts");
+    assert!(rows.iter().all(|r| r["plastic_kg"].as_f64().unwrap() > 0.0));
+    let a = &v["by_angle"][0];
+    assert_eq!(
+        (a["angle_deg"].as_f64(), a["impacts"].as_u64()),
+        (Some(60.0), Some(4))
+    );
+}
+
+#[test]
 fn studies_refuse_bad_input_naming_the_option() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let cases: [(&[&str], &str); 25] = [
+    let cases: [(&[&str], &str); 30] = [
         (
             &["bench", "impact", "--repeat", "0"],
             "'--repeat <REPEAT>': must be a whole number from 1 to 1000",
@@ -170,6 +198,27 @@ fn studies_refuse_bad_input_naming_the_option() {
         (
             &["study", "settle", "--angle", "45", "--strict-fraction", "0.5"],
             "--strict-fraction: must be > 0 and below the scene's settle_fraction 0.02",
+        ),
+        (&["study", "budget"], "angle: required"),
+        (
+            &["study", "budget", "no-such.ckpt", "--angle", "30"],
+            "--angle: a checkpoint carries its own scene",
+        ),
+        (&["study", "budget", "no-such.ckpt"], "no-such.ckpt: cannot read"),
+        (
+            &["study", "budget", "--angle", "45", "--patch", "[1]"],
+            "--patch: must be a JSON object",
+        ),
+        (
+            &[
+                "study",
+                "budget",
+                "--angle",
+                "45",
+                "--patch",
+                r#"{"spacing_m": 1e-5}"#,
+            ],
+            "--patch: spacing_m: cannot change on a worn surface",
         ),
         (
             &["study", "rc", "--jet-speed-m-s", "1e5"],

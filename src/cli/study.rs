@@ -76,6 +76,35 @@ enum Study {
         #[arg(long)]
         json: bool,
     },
+    /// Where erosion comes from, angle by angle: from worn surfaces (farm checkpoints), the
+    /// plastic strain each impact adds, the damage it adds (eq. 19: Δε_p/ε_f, the steady-state
+    /// mass loss it pays for) and the triaxiality it strains under (docs/erosion.md).
+    #[command(
+        after_help = "Example: grit study budget job-*.ckpt --impacts 3 --patch '{\"material\":{\"damage\":{\"d3\":0}}}'"
+    )]
+    Budget {
+        /// Checkpoint files (a job's saved surface, as `grit sample --resume` takes them);
+        /// without them, fresh samples of the scene flags, one per `--seeds`.
+        checkpoints: Vec<std::path::PathBuf>,
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Seeds of the fresh samples (without checkpoints), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1")]
+        seeds: Vec<u64>,
+        /// Impacts to run from each checkpoint or fresh surface.
+        #[arg(long, default_value_t = 3, value_parser = crate::cli::impact_count)]
+        impacts: u32,
+        /// A JSON merge patch (RFC 7396) applied to every checkpoint's scene, e.g. a failure
+        /// constant or the friction; the lattice (spacing, box, grain size) cannot change.
+        #[arg(long)]
+        patch: Option<String>,
+        /// Worker threads (default: all cores); checkpoints run side by side.
+        #[arg(long, value_parser = crate::cli::thread_count)]
+        threads: Option<usize>,
+        /// Print {rows, by_angle} as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Runs a sample and each of its impacts again, from the same surface, with a stricter end
     /// criterion: mass loss and damage must not depend on when an impact ends.
     #[command(
@@ -218,6 +247,25 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             say!("the paper: 166 m/s unresolved at R_c = 2.0 d, 162 m/s resolved");
             Ok(ExitCode::SUCCESS)
         }
+        Study::Budget {
+            checkpoints,
+            scene,
+            seeds,
+            impacts,
+            patch,
+            threads,
+            json,
+        } => {
+            let start = if checkpoints.is_empty() {
+                let p = scene.params()?;
+                Start::Fresh(seeds.iter().map(|&s| (p.clone(), s)).collect())
+            } else if let Some(flag) = scene.first_given() {
+                bail!("{flag}: a checkpoint carries its own scene; give checkpoints or scene flags, not both")
+            } else {
+                Start::Checkpoints(checkpoints)
+            };
+            budget(start, impacts, patch.as_deref(), threads, json)
+        }
         Study::Settle {
             scene,
             impacts,
@@ -268,6 +316,118 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// Where the budget's samples start.
+enum Start {
+    /// Worn surfaces saved by the farm.
+    Checkpoints(Vec<std::path::PathBuf>),
+    /// Fresh surfaces of one scene, one per seed.
+    Fresh(Vec<(grit_erosion::impact::ImpactParams, u64)>),
+}
+
+/// `grit study budget`: every sample, patched, run `impacts` more impacts with the budget
+/// observer; rows and the table by angle.
+fn budget(
+    start: Start,
+    impacts: u32,
+    patch: Option<&str>,
+    threads: Option<usize>,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    use grit_erosion::studies::budget::{budget, by_angle, BudgetRow};
+    use rayon::prelude::*;
+    let patch: Option<serde_json::Value> = patch
+        .map(serde_json::from_str)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("--patch: not JSON: {e}"))?;
+    if patch.as_ref().is_some_and(|p| !p.is_object()) {
+        bail!("--patch: must be a JSON object of scene fields");
+    }
+    let opened: Vec<(String, grit_erosion::Sample)> = match start {
+        Start::Checkpoints(files) => files
+            .iter()
+            .map(|f| {
+                let bytes = std::fs::read(f)
+                    .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", f.display()))?;
+                let s = grit_erosion::Sample::from_checkpoint(&bytes)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
+                Ok((f.display().to_string(), s))
+            })
+            .collect::<anyhow::Result<_>>()?,
+        Start::Fresh(scenes) => scenes
+            .into_iter()
+            .map(|(p, seed)| Ok((format!("seed {seed}"), grit_erosion::Sample::new(p, seed)?)))
+            .collect::<anyhow::Result<_>>()?,
+    };
+    let mut samples = Vec::new();
+    for (f, s) in opened {
+        let s = match &patch {
+            None => s,
+            Some(p) => {
+                let mut v = serde_json::to_value(s.params())?;
+                json_patch::merge(&mut v, p);
+                let params = serde_json::from_value(v).map_err(|e| {
+                    anyhow::anyhow!("--patch: the patched scene does not read: {e}")
+                })?;
+                s.with_params(params)
+                    .map_err(|e| anyhow::anyhow!("--patch: {e}"))?
+            }
+        };
+        samples.push((f, s));
+    }
+    let bar = progress::bar((samples.len() as u64) * impacts as u64, "impacts", true);
+    let runs: Vec<anyhow::Result<Vec<BudgetRow>>> = pool(threads)?.install(|| {
+        samples
+            .par_iter_mut()
+            .map(|(f, s)| {
+                budget(s, impacts, |_| bar.inc(1)).map_err(|e| anyhow::anyhow!("{f}: {e}"))
+            })
+            .collect()
+    });
+    bar.finish();
+    let rows: Vec<BudgetRow> = runs
+        .into_iter()
+        .collect::<anyhow::Result<Vec<_>>>()?
+        .concat();
+    let table = by_angle(&rows);
+    if json {
+        say!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({"rows": rows, "by_angle": table}))?
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    say!("per impact, per grain mass (mg/g), mean ± standard error; dD/de = damage per plastic strain (mean 1/ε_f)");
+    say!("angle impacts  mass loss      Σm·Δε_p        Σm·ΔD         dD/de  mean σ*  ΔD share by σ*: <-1/3  <0    <1/3  ≥1/3   removed with D0 <1/4  <1/2  <3/4  ≥3/4");
+    let pm = |s: &grit_erosion::stats::Stats| {
+        format!("{:>6.2} ± {:<5.2}", s.mean, s.sem.unwrap_or(f64::NAN))
+    };
+    for a in &table {
+        let (sh, cut) = (
+            a.damage_share_by_triaxiality,
+            a.removed_share_by_start_damage,
+        );
+        say!(
+            "{:>5} {:>7}  {}  {}  {}  {:>5.3}  {:>6.3}  {:>20.2} {:>5.2} {:>5.2} {:>5.2}  {:>20.2} {:>5.2} {:>5.2} {:>5.2}",
+            a.angle_deg,
+            a.impacts,
+            pm(&a.mass_loss),
+            pm(&a.plastic),
+            pm(&a.damage),
+            a.damage_per_strain,
+            a.mean_triaxiality,
+            sh[0],
+            sh[1],
+            sh[2],
+            sh[3],
+            cut[0],
+            cut[1],
+            cut[2],
+            cut[3]
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Refuses a coupling-radius scene the study cannot run, naming the flag and the rule.

@@ -5,6 +5,7 @@
 //! drawing charts is the caller's.
 
 pub mod bench;
+pub mod budget;
 pub mod settle;
 pub mod stability;
 pub mod sweep;

@@ -239,6 +239,41 @@ impl Sample {
         Ok(s)
     }
 
+    /// The same surface and seed going on under other scene parameters (for studies of one
+    /// constant's effect from a worn surface). The lattice must stay the one the surface was
+    /// built on: spacing, box and grain size are refused, naming the field.
+    pub fn with_params(mut self, params: ImpactParams) -> Result<Sample, SampleError> {
+        params.validate()?;
+        let old = &self.params;
+        let fixed = [
+            ("spacing_m", old.spacing_m, params.spacing_m),
+            (
+                "surface_width_dg",
+                old.surface_width_dg,
+                params.surface_width_dg,
+            ),
+            (
+                "surface_depth_dg",
+                old.surface_depth_dg,
+                params.surface_depth_dg,
+            ),
+            (
+                "grain_diameter_m",
+                old.grain_diameter_m,
+                params.grain_diameter_m,
+            ),
+        ];
+        if let Some((field, _, _)) = fixed.iter().find(|(_, a, b)| a != b) {
+            return Err(grit_sph::InputError::new(
+                *field,
+                "cannot change on a worn surface: it was built on the checkpoint's lattice",
+            )
+            .into());
+        }
+        self.params = params;
+        Ok(self)
+    }
+
     /// Goes on from `checkpoint()` bytes with the parameters and seed stored in them (for
     /// replaying a job's checkpoint by hand; the farm uses `resume`).
     pub fn from_checkpoint(bytes: &[u8]) -> Result<Sample, SampleError> {
