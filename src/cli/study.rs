@@ -8,7 +8,7 @@ use grit_sph::coupling::DEFAULT_SWITCH_POROSITY;
 use grit_sph::verification::jet_grain::{self, GrainRide, RcScene, BEFORE_CONTACT_D, GRAIN_D};
 
 use super::output::{check_writable, say};
-use super::sample::SceneArgs;
+use super::sample::{read_checkpoint, SceneArgs};
 use super::{pool, progress};
 
 /// Arguments of `grit study`.
@@ -257,8 +257,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             json,
         } => {
             let start = if checkpoints.is_empty() {
-                let p = scene.params()?;
-                Start::Fresh(seeds.iter().map(|&s| (p.clone(), s)).collect())
+                Start::Fresh(Box::new(scene.params()?), seeds)
             } else if let Some(flag) = scene.first_given() {
                 bail!("{flag}: a checkpoint carries its own scene; give checkpoints or scene flags, not both")
             } else {
@@ -323,7 +322,7 @@ enum Start {
     /// Worn surfaces saved by the farm.
     Checkpoints(Vec<std::path::PathBuf>),
     /// Fresh surfaces of one scene, one per seed.
-    Fresh(Vec<(grit_erosion::impact::ImpactParams, u64)>),
+    Fresh(Box<grit_erosion::impact::ImpactParams>, Vec<u64>),
 }
 
 /// `grit study budget`: every sample, patched, run `impacts` more impacts with the budget
@@ -347,17 +346,14 @@ fn budget(
     let opened: Vec<(String, grit_erosion::Sample)> = match start {
         Start::Checkpoints(files) => files
             .iter()
-            .map(|f| {
-                let bytes = std::fs::read(f)
-                    .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", f.display()))?;
-                let s = grit_erosion::Sample::from_checkpoint(&bytes)
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
-                Ok((f.display().to_string(), s))
-            })
+            .map(|f| Ok((f.display().to_string(), read_checkpoint(f)?)))
             .collect::<anyhow::Result<_>>()?,
-        Start::Fresh(scenes) => scenes
+        Start::Fresh(params, seeds) => seeds
             .into_iter()
-            .map(|(p, seed)| Ok((format!("seed {seed}"), grit_erosion::Sample::new(p, seed)?)))
+            .map(|seed| {
+                let s = grit_erosion::Sample::new((*params).clone(), seed)?;
+                Ok((format!("seed {seed}"), s))
+            })
             .collect::<anyhow::Result<_>>()?,
     };
     let mut samples = Vec::new();

@@ -79,6 +79,12 @@ struct SampleOutput<'a> {
     error: Option<String>,
 }
 
+/// A checkpoint file (a job's saved surface) as the sample it holds; errors name the file.
+pub fn read_checkpoint(path: &std::path::Path) -> anyhow::Result<Sample> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    Sample::from_checkpoint(&bytes).with_context(|| format!("{}", path.display()))
+}
+
 /// Runs one sample locally with a progress bar and prints its mass-loss series.
 pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &a.result.out {
@@ -90,9 +96,7 @@ pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
             if let Some(flag) = a.scene.first_given().or(seed) {
                 bail!("{flag}: --resume runs the scene and seed stored in the checkpoint; leave the scene flags out");
             }
-            let bytes =
-                std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-            Sample::from_checkpoint(&bytes).with_context(|| format!("resume {}", path.display()))?
+            read_checkpoint(path)?
         }
         None => Sample::new(a.scene.params()?, a.seed.unwrap_or(1))?,
     };

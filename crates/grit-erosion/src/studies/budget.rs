@@ -81,6 +81,8 @@ struct Seen {
     bin: usize,
     present: bool,
     failed: bool,
+    /// The observed step that last found this particle in the world.
+    stamp: u64,
 }
 
 /// Sums of one impact, filled step by step.
@@ -89,6 +91,11 @@ struct Tally {
     plastic: [f64; BINS],
     damage: [f64; BINS],
     plastic_triax: f64,
+}
+
+/// Quarter of D in [0, 1] a removed particle's damage before the impact falls in.
+fn quarter(damage: f64) -> usize {
+    ((4.0 * damage) as usize).min(3)
 }
 
 fn bin_of(triax: f64) -> usize {
@@ -122,8 +129,11 @@ pub fn budget(
                 bin: bin_of(0.0),
                 failed: false,
                 present: true,
+                stamp: 0,
             };
         }
+        let mut present = seen.iter().filter(|s| s.present).count();
+        let mut step = 0u64;
         let stock: f64 = seen.iter().map(|s| s.mass * s.damage).sum();
         let mut tally = Tally::default();
         let mut removed = [0.0; 4];
@@ -131,14 +141,16 @@ pub fn budget(
         let mut observe = |w: &World| {
             let p = w.particles();
             let pressure = w.pressures();
-            let mut here = vec![false; size];
+            step += 1;
+            let mut found = 0;
             for (i, &pr) in pressure.iter().enumerate() {
                 if p.body[i] as usize != SURFACE_BODY || p.flags[i] & KINEMATIC != 0 {
                     continue;
                 }
                 let id = p.id[i] as usize;
                 let Some(s) = seen.get_mut(id) else { continue };
-                here[id] = true;
+                s.stamp = step;
+                found += 1;
                 let triax = triaxiality(pr, von_mises(&p.sdev[i]));
                 let bin = bin_of(triax);
                 let (de, dd) = (p.eps_p[i] - s.eps_p, p.damage[i] - s.damage);
@@ -155,9 +167,13 @@ pub fn budget(
             let now = w.bodies()[SURFACE_BODY].removed_particles;
             let to_one = now > failed;
             failed = now;
-            for (id, s) in seen.iter_mut().enumerate() {
-                if s.present && !here[id] {
-                    removed[((4.0 * s.start_damage) as usize).min(3)] += s.mass;
+            if found == present {
+                return; // nobody left in this step
+            }
+            present = found;
+            for s in seen.iter_mut() {
+                if s.present && s.stamp != step {
+                    removed[quarter(s.start_damage)] += s.mass;
                     if to_one {
                         tally.damage[s.bin] += s.mass * (1.0 - s.damage).max(0.0);
                         s.failed = true;
@@ -177,7 +193,7 @@ pub fn budget(
             }
         }
         for (s, _) in seen.iter().zip(&kept).filter(|(s, k)| s.present && !**k) {
-            removed[((4.0 * s.start_damage) as usize).min(3)] += s.mass;
+            removed[quarter(s.start_damage)] += s.mass;
         }
         let plastic: f64 = tally.plastic.iter().sum();
         // A particle's last seen state, or D = 1 for one that failed.
