@@ -150,6 +150,7 @@ fn synthetic_results() -> serde_json::Value {
                                 steps: 1000,
                                 rebound_ratio: 0.5,
                                 settled: true,
+                                damage_added_kg: None,
                             },
                         }
                     })

@@ -280,6 +280,7 @@ pub(crate) fn placeholder_record(
             steps: 0,
             rebound_ratio: 0.0,
             settled: true,
+            damage_added_kg: None,
         },
     }
 }

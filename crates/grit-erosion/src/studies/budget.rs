@@ -352,7 +352,15 @@ mod tests {
         } else {
             assert!(total_eps <= first * (1.0 + 1e-9), "{total_eps} > {first}");
         }
-        for r in &rows {
+        for (r, rec) in rows.iter().zip(watched.records()) {
+            // The record's damage added, from the stocks before and after, is what the observer
+            // charged step by step.
+            let added = rec.outcome.damage_added_kg.expect("new records carry it");
+            assert!(
+                (added - r.damage_kg).abs() <= 1e-9 * r.damage_kg.abs().max(1e-12),
+                "{added} vs {}",
+                r.damage_kg
+            );
             let bins: f64 = r.plastic_by_triaxiality_kg.iter().sum();
             assert!((bins - r.plastic_kg).abs() <= 1e-12 * r.plastic_kg.abs());
             assert!(r.damage_kg >= 0.0 && r.plastic_kg >= 0.0);

@@ -32,6 +32,11 @@ pub struct ImpactOutcome {
     pub rebound_ratio: f64,
     /// True when the end criterion was met; false when the time limit ended the impact.
     pub settled: bool,
+    /// Damage the impact added to the surface, Σ m ΔD over its free particles, a failed particle
+    /// counted to D = 1 (kg/m; eq. 19): what a stationary surface's mass loss pays for
+    /// (docs/erosion.md, *The damage balance*). `None` in records written before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damage_added_kg: Option<f64>,
 }
 
 /// Why an impact stopped without a result.
@@ -182,13 +187,14 @@ pub fn run_impact_observed(
         }
     }
     let (s, g) = (SURFACE_BODY, GRAIN_BODY);
+    let damage_before = damage_stock(surface);
     let e0 = world.energy().kinetic;
     let particles = world.particles().len();
     let dg = params.grain_diameter_m;
     let half_width = 0.5 * params.surface_width_dg * dg;
     let t_max = max_impact_time(params);
     let mut quiet = 0u32;
-    let (mut detached_kg, mut detached_particles) = (0.0, 0u32);
+    let (mut detached_kg, mut detached_particles, mut detached_damage) = (0.0, 0u32, 0.0);
     let mut settled = false;
     while world.time() < t_max {
         if cancel() {
@@ -216,6 +222,7 @@ pub fn run_impact_observed(
                 for (i, _) in keep.iter().enumerate().filter(|(_, k)| !**k) {
                     detached_kg += p.mass[i];
                     detached_particles += 1;
+                    detached_damage += p.mass[i] * p.damage[i];
                 }
                 world.remove_particles(&keep)?;
             }
@@ -228,6 +235,10 @@ pub fn run_impact_observed(
         }
     }
     let r = world.bodies()[g].rigid().expect("grain is rigid");
+    let after = world.body_state(s);
+    // Failed particles left at D = 1 (eq. 19); fragments took the damage they had.
+    let damage_added = damage_stock(&after) + world.bodies()[s].removed_mass_kg_m + detached_damage
+        - damage_before;
     let outcome = ImpactOutcome {
         mass_loss_kg: world.bodies()[s].removed_mass_kg_m + detached_kg,
         removed_particles: world.bodies()[s].removed_particles as u32,
@@ -237,9 +248,10 @@ pub fn run_impact_observed(
         steps: world.steps() - skipped_steps,
         rebound_ratio: r.velocity_m_s.norm() / params.velocity_m_s,
         settled,
+        damage_added_kg: Some(damage_added),
     };
     Ok(ImpactRun {
-        surface: world.body_state(s),
+        surface: after,
         outcome,
         timers: world.timers().clone(),
         particles,
@@ -426,6 +438,15 @@ fn attached(world: &World, s: usize, link: f64) -> Vec<bool> {
     (0..n)
         .map(|i| p.body[i] as usize != s || anchored[root(&mut parent, i)])
         .collect()
+}
+
+/// Σ m D over a surface's free particles (kg/m): the damage stock (the fixed layers never
+/// fail).
+pub fn damage_stock(surface: &Particles) -> f64 {
+    (0..surface.len())
+        .filter(|&i| surface.flags[i] & KINEMATIC == 0)
+        .map(|i| surface.mass[i] * surface.damage[i])
+        .sum()
 }
 
 fn grain_kinetic(world: &World, g: usize) -> f64 {

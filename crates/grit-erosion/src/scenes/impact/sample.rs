@@ -531,4 +531,15 @@ mod tests {
             "surface state differs"
         );
     }
+
+    #[test]
+    fn records_from_before_the_damage_field_read_and_write_back_unchanged() {
+        let old = r#"{"impact":1,"grain_mass_kg":0.0001227184630308513,"mass_loss_kg":0.0,"orientation_rad":3.790436142777147,"aim_x_m":0.000045968645586082495,"outcome":{"mass_loss_kg":0.0,"removed_particles":0,"detached_kg":0.0,"detached_particles":0,"sim_time_s":8.707224782726366e-7,"steps":395,"rebound_ratio":0.6120364083264578,"settled":true}}"#;
+        let r: ImpactRecord = serde_json::from_str(old).unwrap();
+        assert_eq!(r.outcome.damage_added_kg, None);
+        assert_eq!(serde_json::to_string(&r).unwrap(), old);
+        let mut s = Sample::new(coarse(), 7).unwrap();
+        let added = s.run_next().unwrap().outcome.damage_added_kg;
+        assert!(added.is_some_and(|d| d > 0.0), "{added:?}");
+    }
 }
