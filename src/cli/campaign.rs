@@ -261,8 +261,14 @@ fn say_cells(results: &AnyResults) {
     match results {
         AnyResults::Impact(r) => {
             for c in &r.results.cells {
+                // Below 1 while the surface still stores more damage than it loses
+                // (docs/erosion.md, "The damage balance").
+                let paid = c
+                    .damage_balance
+                    .and_then(|b| b.ratio)
+                    .map_or(String::new(), |q| format!("  loss/damage added {q:.2}"));
                 say!(
-                    "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}",
+                    "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}{paid}",
                     c.angle_deg,
                     c.shape,
                     c.samples,
@@ -318,7 +324,8 @@ fn warn_unsteady_any(results: &AnyResults, all: bool) {
 }
 
 /// Warns on stderr of every cell whose erosion is not a steady-state rate (docs/erosion.md,
-/// *Steady state*), so stdout and JSON output stay clean. Without `all`, only cells that
+/// *Steady state*), and notes every cell whose loss does not yet pay for its damage, so stdout
+/// and JSON output stay clean. Without `all`, only cells that
 /// have all their samples are judged: a running cell is not yet at steady state by design.
 fn warn_unsteady(results: &CampaignResults, all: bool) {
     let mut judged = results.clone();
@@ -326,6 +333,9 @@ fn warn_unsteady(results: &CampaignResults, all: bool) {
         judged.cells.retain(|c| !c.partial);
     }
     for line in judged.unsteady_warnings() {
+        eprintln!("{line}");
+    }
+    for line in judged.unbalanced_notes() {
         eprintln!("{line}");
     }
 }

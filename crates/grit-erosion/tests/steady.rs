@@ -19,6 +19,7 @@ fn sample(index: u32, n: usize, loss: impl Fn(usize) -> f64) -> SampleInput {
             .map(|k| Impact {
                 grain_mass_kg: GRAIN_KG,
                 mass_loss_kg: loss(k) * GRAIN_KG,
+                damage_added_kg: None,
             })
             .collect(),
     }

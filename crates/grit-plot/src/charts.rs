@@ -129,6 +129,7 @@ fn sample_curve(r: &RawSeries) -> Vec<(f64, f64)> {
         .map(|m| Impact {
             grain_mass_kg: m.grain_mass_kg,
             mass_loss_kg: m.mass_loss_kg,
+            damage_added_kg: None,
         })
         .collect();
     cumulative_series(&impacts)

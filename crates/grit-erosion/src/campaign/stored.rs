@@ -60,6 +60,9 @@ pub struct UnitMasses {
     pub grain_kg_m: f64,
     /// Target mass the unit removed (kg/m).
     pub loss_kg_m: f64,
+    /// Damage the unit added to the target, Σ m ΔD (kg/m; seed paper eq. 19), which the
+    /// impact scene's damage balance compares with the loss; `None` where not recorded.
+    pub damage_kg_m: Option<f64>,
 }
 
 /// One job with the records it stored, as a raw results listing shows it.

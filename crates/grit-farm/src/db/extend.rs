@@ -107,7 +107,8 @@ pub(super) async fn settle_cell(
     // A unit stored before its masses had columns is read from its record.
     let rows = sqlx::query(
         "SELECT j.sample_index, u.grain_kg_m, u.loss_kg_m,
-                CASE WHEN u.grain_kg_m IS NULL OR u.loss_kg_m IS NULL THEN u.record END
+                CASE WHEN u.grain_kg_m IS NULL OR u.loss_kg_m IS NULL THEN u.record END,
+                u.damage_kg_m
          FROM units u JOIN jobs j ON j.id = u.job_id
          WHERE j.campaign_id = ? AND j.cell_index = ? ORDER BY j.sample_index, u.unit",
     )
@@ -121,6 +122,7 @@ pub(super) async fn settle_cell(
             (Some(grain_kg_m), Some(loss_kg_m)) => UnitMasses {
                 grain_kg_m,
                 loss_kg_m,
+                damage_kg_m: r.get::<Option<f64>, _>(4),
             },
             _ => scene.masses(r.get::<&str, _>(3))?.ok_or_else(|| {
                 Error::Internal(format!("cell {cell} grows, but its scene reads no masses"))

@@ -220,6 +220,37 @@ async fn a_repeated_complete_grows_nothing_twice() {
     assert_eq!(s.status(id).await.unwrap().impacts_total, 25);
 }
 
+#[tokio::test]
+async fn each_units_damage_added_is_stored_beside_its_masses_and_balances_the_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let id = s.create_campaign(&spec("21", "2"), None).await.unwrap().id;
+    for _ in 0..2 {
+        let j = s.claim("w").await.unwrap().expect("a queued job");
+        let recs: Vec<ImpactRecord> = (1..=21)
+            .map(|k| {
+                let mut r = record(&j, k, 1e-3 * (1 + j.sample) as f64);
+                r.outcome.damage_added_kg = Some(2e-3 * r.grain_mass_kg);
+                r
+            })
+            .collect();
+        s.complete(j.job_id, j.lease_id, imp(&recs)).await.unwrap();
+    }
+    let (units, damaged): (i64, i64) =
+        sqlx::query("SELECT COUNT(*), COUNT(damage_kg_m) FROM units")
+            .fetch_one(&s.read)
+            .await
+            .map(|r| (r.get(0), r.get(1)))
+            .unwrap();
+    assert_eq!((units, damaged), (42, 42));
+    let b = impact_results(&s, id).await.cells[0]
+        .damage_balance
+        .unwrap();
+    // Samples lost 1 and 2 mg/g against 2 mg/g of damage added each.
+    assert_eq!(b.samples, 2);
+    assert!((b.ratio.unwrap() - 0.75).abs() < 1e-9, "{b:?}");
+}
+
 /// What judging a finished cell costs the writer, for a cell of 25 samples × 400 impacts:
 /// its last completion (which judges it) against the others, and the read of its units'
 /// masses from their columns against parsing every record. Run by hand, on an idle machine:

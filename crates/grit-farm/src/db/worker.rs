@@ -778,7 +778,7 @@ async fn store_units(
     {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
             "INSERT INTO units (job_id, unit, lost_kg_m, record, created_ms, grain_kg_m, loss_kg_m,
-                                engine) ",
+                                damage_kg_m, engine) ",
         );
         qb.push_values(chunk, |mut b, (&i, &lost)| {
             let (n, json) = &units.rows[i];
@@ -790,6 +790,7 @@ async fn store_units(
                 .push_bind(now)
                 .push_bind(masses.map(|m| m.grain_kg_m))
                 .push_bind(masses.map(|m| m.loss_kg_m))
+                .push_bind(masses.and_then(|m| m.damage_kg_m))
                 .push_bind(held.engine.as_deref());
         });
         qb.build().execute(&mut **tx).await?;

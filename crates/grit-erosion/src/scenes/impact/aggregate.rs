@@ -19,6 +19,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::balance::{self, DamageBalance};
 use super::steady::{self, SteadyState};
 use crate::stats::{invalid, least_squares_slope, stats, AggregateError};
 
@@ -32,6 +33,10 @@ pub struct Impact {
     pub grain_mass_kg: f64,
     /// Surface mass removed by this impact (failed particles), kg (per metre in 2D).
     pub mass_loss_kg: f64,
+    /// Damage the impact added to the surface, Σ m ΔD (eq. 19), kg (per metre in 2D);
+    /// absent where it was not recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damage_added_kg: Option<f64>,
 }
 
 /// One point of a cumulative series: after impact k, the totals so far (Fig. 8).
@@ -152,6 +157,10 @@ pub struct CellResult {
     /// results files written before the check existed.
     #[serde(default)]
     pub steady_state: Option<SteadyState>,
+    /// Loss against damage added over the last window ([`crate::impact::balance`]); absent
+    /// where the records carry no damage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damage_balance: Option<DamageBalance>,
 }
 
 impl CellResult {
@@ -217,6 +226,27 @@ impl CampaignResults {
             .iter()
             .map(|c| c.steady_state.as_ref().map(|s| s.steady))
             .try_fold(true, |all, s| s.map(|s| all && s))
+    }
+
+    /// One line per cell whose last window's loss does not pay for the damage its impacts
+    /// added ([`crate::impact::balance`]): its rate is steady, perhaps, but not yet stationary.
+    pub fn unbalanced_notes(&self) -> Vec<String> {
+        self.cells
+            .iter()
+            .filter_map(|c| {
+                let b = c.damage_balance.filter(|b| !b.balanced)?;
+                let what = if b.loss_rate < b.damage_rate {
+                    "still stores damage; its stationary rate lies between the two"
+                } else {
+                    "loses more than its impacts damage"
+                };
+                Some(format!(
+                    "note: cell {}: {}: the surface {what} (docs/erosion.md, The damage balance)",
+                    c.label(),
+                    b.describe()
+                ))
+            })
+            .collect()
     }
 
     /// One line per cell that is not at steady state, or was not checked, saying why
@@ -387,6 +417,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         })
         .collect();
 
+    let damage_balance = balance::assess(&samples);
     let steady_state = steady::assess(&series, &mean_series);
     let summary = stats(&slopes);
     let partial = samples.len() < cell.planned_samples
@@ -409,6 +440,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         mean_series,
         convergence: convergence(&slopes),
         steady_state: Some(steady_state),
+        damage_balance,
     })
 }
 
@@ -448,6 +480,7 @@ mod tests {
             .map(|k| Impact {
                 grain_mass_kg: 1e-4,
                 mass_loss_kg: if k < incubation { 0.0 } else { rate * 1e-4 },
+                damage_added_kg: None,
             })
             .collect();
         SampleInput {
@@ -649,9 +682,9 @@ mod tests {
         ) {
             let mut impacts: Vec<Impact> = early
                 .iter()
-                .map(|&l| Impact { grain_mass_kg: 1e-4, mass_loss_kg: l })
+                .map(|&l| Impact { grain_mass_kg: 1e-4, mass_loss_kg: l, damage_added_kg: None })
                 .collect();
-            impacts.extend((0..SLOPE_WINDOW).map(|_| Impact { grain_mass_kg: 1e-4, mass_loss_kg: rate * 1e-4 }));
+            impacts.extend((0..SLOPE_WINDOW).map(|_| Impact { grain_mass_kg: 1e-4, mass_loss_kg: rate * 1e-4, damage_added_kg: None }));
             let e = sample_erosion(&cumulative_series(&impacts), SLOPE_WINDOW).unwrap();
             prop_assert!((e - rate).abs() <= 1e-9 * rate);
         }

@@ -3,6 +3,7 @@
 //! the aggregation of mass-loss curves into steady-state erosion.
 
 pub mod aggregate;
+pub mod balance;
 mod params;
 mod run;
 pub mod sample;

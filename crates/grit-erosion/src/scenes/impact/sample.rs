@@ -16,7 +16,10 @@ use crate::scene::{stream_draws, Scene, SceneError};
 
 /// Bumped whenever the checkpoint layout or the physics behind it changes, so an old
 /// checkpoint is refused instead of resumed into different numbers.
-pub const CHECKPOINT_VERSION: u32 = 7;
+pub const CHECKPOINT_VERSION: u32 = 8;
+/// The last version whose records were postcard in their layout before `damage_added_kg`;
+/// still read.
+const POSTCARD_RECORDS_VERSION: u32 = 7;
 /// The last version whose surface was `Particles`' own serde layout; still read.
 const PARTICLES_VERSION: u32 = 6;
 /// The version before checkpoints carried their checksum; still read.
@@ -47,6 +50,7 @@ impl ImpactRecord {
         Impact {
             grain_mass_kg: self.grain_mass_kg,
             mass_loss_kg: self.mass_loss_kg,
+            damage_added_kg: self.outcome.damage_added_kg,
         }
     }
 }
@@ -79,7 +83,19 @@ struct Checkpoint {
     params_json: String,
     seed: u64,
     surface: ParticlesState,
-    records: Vec<ImpactRecord>,
+    /// JSON too: a record gains optional fields (read as absent from older records), and
+    /// postcard, which writes fields by position, cannot skip one.
+    records_json: String,
+}
+
+/// A checkpoint of version 7: the records in postcard.
+#[derive(Deserialize)]
+struct CheckpointV7 {
+    _version: u32,
+    params_json: String,
+    seed: u64,
+    surface: ParticlesState,
+    records: Vec<RecordV7>,
 }
 
 /// A checkpoint of versions 5 and 6: the surface in `Particles`' own serde layout.
@@ -90,7 +106,60 @@ struct CheckpointV6 {
     seed: u64,
     #[serde(deserialize_with = "grit_sph::particles::deserialize_filled")]
     surface: Particles,
-    records: Vec<ImpactRecord>,
+    records: Vec<RecordV7>,
+}
+
+/// An [`ImpactRecord`] as postcard laid it out in checkpoints of versions 5 to 7.
+#[derive(Deserialize)]
+struct RecordV7 {
+    impact: u32,
+    grain_mass_kg: f64,
+    mass_loss_kg: f64,
+    orientation_rad: f64,
+    aim_x_m: f64,
+    outcome: OutcomeV7,
+}
+
+/// An [`ImpactOutcome`] before it recorded the damage added.
+#[derive(Deserialize)]
+struct OutcomeV7 {
+    mass_loss_kg: f64,
+    removed_particles: u32,
+    detached_kg: f64,
+    detached_particles: u32,
+    sim_time_s: f64,
+    steps: u64,
+    rebound_ratio: f64,
+    settled: bool,
+}
+
+impl From<RecordV7> for ImpactRecord {
+    fn from(r: RecordV7) -> ImpactRecord {
+        let o = r.outcome;
+        ImpactRecord {
+            impact: r.impact,
+            grain_mass_kg: r.grain_mass_kg,
+            mass_loss_kg: r.mass_loss_kg,
+            orientation_rad: r.orientation_rad,
+            aim_x_m: r.aim_x_m,
+            outcome: ImpactOutcome {
+                mass_loss_kg: o.mass_loss_kg,
+                removed_particles: o.removed_particles,
+                detached_kg: o.detached_kg,
+                detached_particles: o.detached_particles,
+                sim_time_s: o.sim_time_s,
+                steps: o.steps,
+                rebound_ratio: o.rebound_ratio,
+                settled: o.settled,
+                damage_added_kg: None,
+            },
+        }
+    }
+}
+
+/// Records of a checkpoint before version 8, as today's.
+fn records_v7(records: Vec<RecordV7>) -> Vec<ImpactRecord> {
+    records.into_iter().map(ImpactRecord::from).collect()
 }
 
 /// N impacts on one surface, deterministic in (params, seed).
@@ -219,7 +288,7 @@ impl Sample {
             params_json: serde_json::to_string(&self.params).expect("params serialise"),
             seed: self.seed,
             surface: self.surface.state(),
-            records: self.records.clone(),
+            records_json: serde_json::to_string(&self.records).expect("records serialise"),
         };
         let mut bytes = postcard::to_stdvec(&c).expect("a checkpoint always serialises");
         let digest = Sha256::digest(&bytes);
@@ -294,12 +363,22 @@ impl Sample {
                     postcard::take_from_bytes(bytes).map_err(undecodable)?;
                 let surface = Particles::from_state(c.surface)
                     .map_err(|e| SampleError::Checkpoint(format!("surface: {e}")))?;
-                ((c.params_json, c.seed, surface, c.records), rest)
+                let records = serde_json::from_str(&c.records_json).map_err(|e| {
+                    SampleError::Checkpoint(format!("cannot decode records: {e}"))
+                })?;
+                ((c.params_json, c.seed, surface, records), rest)
+            }
+            POSTCARD_RECORDS_VERSION => {
+                let (c, rest): (CheckpointV7, &[u8]) =
+                    postcard::take_from_bytes(bytes).map_err(undecodable)?;
+                let surface = Particles::from_state(c.surface)
+                    .map_err(|e| SampleError::Checkpoint(format!("surface: {e}")))?;
+                ((c.params_json, c.seed, surface, records_v7(c.records)), rest)
             }
             PARTICLES_VERSION | UNCHECKED_VERSION => {
                 let (c, rest): (CheckpointV6, &[u8]) =
                     postcard::take_from_bytes(bytes).map_err(undecodable)?;
-                ((c.params_json, c.seed, c.surface, c.records), rest)
+                ((c.params_json, c.seed, c.surface, records_v7(c.records)), rest)
             }
             v => {
                 return Err(SampleError::Checkpoint(format!(
@@ -308,7 +387,7 @@ impl Sample {
             }
         };
         match version {
-            CHECKPOINT_VERSION | PARTICLES_VERSION => {
+            CHECKPOINT_VERSION | POSTCARD_RECORDS_VERSION | PARTICLES_VERSION => {
                 let body = &bytes[..bytes.len() - rest.len()];
                 if rest.len() != SHA256_LEN {
                     return Err(SampleError::Checkpoint(format!(

@@ -24,11 +24,12 @@ fn input(cell: &StoredCell, samples: Vec<SampleInput>) -> CellInput {
     }
 }
 
-/// An impact's grain mass and loss, all the aggregation reads of it.
+/// An impact's grain mass, loss and damage added, all the aggregation reads of it.
 pub(crate) fn masses(r: &ImpactRecord) -> UnitMasses {
     UnitMasses {
         grain_kg_m: r.grain_mass_kg,
         loss_kg_m: r.mass_loss_kg,
+        damage_kg_m: r.outcome.damage_added_kg,
     }
 }
 
@@ -44,6 +45,7 @@ where
                 .map(|m| Impact {
                     grain_mass_kg: m.grain_kg_m,
                     mass_loss_kg: m.loss_kg_m,
+                    damage_added_kg: m.damage_kg_m,
                 })
                 .collect(),
         })
