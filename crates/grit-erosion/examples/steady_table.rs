@@ -11,8 +11,8 @@ use grit_erosion::impact::aggregate::CampaignResults;
 use grit_erosion::impact::steady::reassess;
 use grit_erosion::stats::SlopeFit;
 
-/// Two adjacent slopes' difference (later minus earlier) in combined standard errors, the
-/// quantity of condition 1.
+/// Two slopes' difference (later minus earlier) in combined standard errors, the quantity of
+/// condition 1.
 fn z(a: Option<SlopeFit>, b: Option<SlopeFit>) -> String {
     match (a, b) {
         (Some(a), Some(b)) if a.sem.hypot(b.sem) > 0.0 => {
@@ -43,7 +43,7 @@ fn run(path: &str) -> Result<(), String> {
     println!("\n{path}\n");
     println!(
         "| cell | samples | impacts | last 20 (mg/g) | previous 20 (mg/g) | the 20 before (mg/g) \
-         | differences (combined s.e.) | sees changes of | steady (stored rule) | steady (this rule) |"
+         | differences: adjacent; ends (combined s.e.) | sees changes of | steady (stored rule) | steady (this rule) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for c in &stored.cells {
@@ -54,9 +54,10 @@ fn run(path: &str) -> Result<(), String> {
                 show(s.slope_prev),
                 show(s.slope_before),
                 format!(
-                    "{}, {}",
+                    "{}, {}; ends {}",
                     z(s.slope_last, s.slope_prev),
-                    z(s.slope_prev, s.slope_before)
+                    z(s.slope_prev, s.slope_before),
+                    z(s.slope_last, s.slope_before)
                 ),
                 s.detectable_change_rel
                     .map_or("–".into(), |d| format!("{:.0} %", 100.0 * d)),

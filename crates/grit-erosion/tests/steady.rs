@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use grit_erosion::impact::aggregate::{aggregate_campaign, aggregate_cell, CellInput, SampleInput};
 use grit_erosion::impact::steady::{reassess, Incubation, STEADY_POINTS};
-use grit_erosion::stats::slope_fit;
+use grit_erosion::stats::{slope_fit, SlopeFit};
 use grit_erosion::{CampaignResults, Impact, SLOPE_WINDOW};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -37,6 +37,9 @@ fn cell(impacts: usize, samples: Vec<SampleInput>) -> CellInput {
 }
 
 /// Deterministic scatter in [-1, 1] that differs between samples and impacts.
+/// Rise of the rate per impact, relative, of the slow-rise test.
+const RISE: f64 = 0.0016;
+
 fn wiggle(s: u32, k: usize) -> f64 {
     (1.7 * k as f64 + 2.3 * s as f64).sin()
 }
@@ -145,6 +148,32 @@ fn a_peak_after_incubation_is_not_steady() {
     );
     assert!((last.value - prev.value).abs() <= 2.0 * last.sem.hypot(prev.sem));
     assert!(prev.value > 1.5 * before.value, "{prev:?} {before:?}");
+}
+
+#[test]
+fn a_slow_rise_that_every_adjacent_pair_passes_is_not_steady() {
+    // The rate climbs a little each window: no two neighbours differ by 2 combined standard
+    // errors, the ends do (the seed's campaign at 45°: 2.97, 3.33, 3.70 mg/g).
+    let r = aggregate_cell(
+        &noisy_cell(|k| 2e-3 * (1.0 + RISE * k as f64)),
+        SLOPE_WINDOW,
+    )
+    .unwrap();
+    let s = r.steady_state.unwrap();
+    let (last, prev, before) = (
+        s.slope_last.unwrap(),
+        s.slope_prev.unwrap(),
+        s.slope_before.unwrap(),
+    );
+    let z = |a: SlopeFit, b: SlopeFit| (a.value - b.value).abs() / a.sem.hypot(b.sem);
+    assert!(z(last, prev) < 2.0 && z(prev, before) < 2.0, "{}", s.reason);
+    assert!(z(last, before) > 2.0);
+    assert!(!s.steady);
+    assert!(
+        s.reason.contains("a trend across the three"),
+        "{}",
+        s.reason
+    );
 }
 
 #[test]
