@@ -25,6 +25,10 @@ pub struct UntilSteady {
     /// Impacts added to every sample of an unsteady cell at a time.
     #[serde(deserialize_with = "count")]
     pub step: u32,
+    /// Grow also while the last window's loss does not pay for the damage its impacts added
+    /// ([`crate::impact::balance`]): a steady cell counts as done only once it is stationary.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub balanced: bool,
 }
 
 impl UntilSteady {
@@ -305,7 +309,8 @@ pub fn next_step(
     target: Option<TargetSem>,
 ) -> NextStep {
     if let Some(u) = until {
-        let steady = cell.steady_state.as_ref().is_some_and(|s| s.steady);
+        let steady = cell.steady_state.as_ref().is_some_and(|s| s.steady)
+            && (!u.balanced || cell.damage_balance.is_some_and(|b| b.balanced));
         let planned = cell.impacts_planned as u32;
         if !steady && planned < u.max {
             return NextStep::ExtendImpacts(planned.saturating_add(u.step).min(u.max));
@@ -359,6 +364,7 @@ mod tests {
             min: 21,
             max: 60,
             step: 5,
+            balanced: false,
         };
         let s = CampaignSpec::from_json(
             r#"{"angles_deg": [15, 45], "impacts": {"until_steady": {"min": 21, "max": 60, "step": 5}}}"#,

@@ -110,8 +110,9 @@ impl Store {
         for cell in &plan.cells {
             sqlx::query(
                 "INSERT INTO cells (campaign_id, cell_index, angle_deg, shape, swept, units, params,
-                                    samples, units_max, units_step, samples_max, target_sem_rel)
-                 VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                                    samples, units_max, units_step, units_balanced, samples_max,
+                                    target_sem_rel)
+                 VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             )
             .bind(id.to_string())
             .bind(cell.index as i64)
@@ -123,6 +124,7 @@ impl Store {
             .bind(plan.samples as i64)
             .bind(cell.until_steady.map(|u| u.max as i64))
             .bind(cell.until_steady.map(|u| u.step as i64))
+            .bind(cell.until_steady.map(|u| u.balanced))
             .bind(target.map(|t| t.max as i64))
             .bind(target.map(|t| t.target_sem_rel))
             .execute(&mut *tx)

@@ -28,6 +28,7 @@ pub(super) fn stored_cell(r: &sqlx::sqlite::SqliteRow) -> Result<StoredCell> {
             min: units.min(max as u32),
             max: max as u32,
             step: step as u32,
+            balanced: r.get::<Option<bool>, _>("units_balanced").unwrap_or(false),
         }),
         _ => None,
     };
@@ -59,7 +60,7 @@ pub(super) fn stored_cell(r: &sqlx::sqlite::SqliteRow) -> Result<StoredCell> {
 
 /// The columns of `cells` that [`stored_cell`] reads.
 pub(super) const CELL_COLUMNS: &str = "cell_index, angle_deg, shape, swept, params, units, samples,
-     units_max, units_step, samples_max, target_sem_rel";
+     units_max, units_step, units_balanced, samples_max, target_sem_rel";
 
 impl Store {
     /// Every cell of campaign `id` as it stands now, in cell order.

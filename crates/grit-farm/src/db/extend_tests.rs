@@ -42,9 +42,22 @@ fn checkpoint(j: &ClaimedJob) -> CheckpointBytes {
 /// Claims the next job and completes it with impacts lost at `loss(sample, k)`, sending a
 /// checkpoint when the claim asks for one. Returns the claim.
 async fn run_one(s: &Store, loss: impl Fn(u32, u32) -> f64) -> ClaimedJob {
+    run_one_adding(s, loss, None).await
+}
+
+/// [`run_one`] with every impact adding `added` × its grain mass of damage, when given.
+async fn run_one_adding(
+    s: &Store,
+    loss: impl Fn(u32, u32) -> f64,
+    added: Option<f64>,
+) -> ClaimedJob {
     let j = s.claim("w").await.unwrap().expect("a queued job");
     let recs: Vec<ImpactRecord> = (j.impacts_done + 1..=j.impacts_planned)
-        .map(|k| record(&j, k, loss(j.sample, k)))
+        .map(|k| {
+            let mut r = record(&j, k, loss(j.sample, k));
+            r.outcome.damage_added_kg = added.map(|a| a * r.grain_mass_kg);
+            r
+        })
         .collect();
     let ckpt = j.extendable.then(|| checkpoint(&j));
     s.complete(j.job_id, j.lease_id, imp(&recs).with_checkpoint(ckpt))
@@ -133,6 +146,33 @@ async fn a_steady_cell_is_not_extended() {
     let r = impact_results(&s, id).await;
     assert_eq!(r.cells[0].impacts_planned, 60);
     assert_eq!(r.steady, Some(true));
+}
+
+#[tokio::test]
+async fn a_cell_that_waits_for_the_balance_grows_until_its_loss_pays_for_its_damage() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = spec(
+        r#"{"until_steady": {"min": 60, "max": 100, "step": 20, "balanced": true}}"#,
+        "2",
+    );
+    let id = s.create_campaign(&sp, None).await.unwrap().id;
+    // Steady loss (as in a_steady_cell_is_not_extended, done there at 60), but twice that
+    // damage added: the stock grows, so the cell grows.
+    let loss = |sample: u32, _| 0.1 + 0.01 * sample as f64;
+    run_one_adding(&s, loss, Some(0.2)).await;
+    run_one_adding(&s, loss, Some(0.2)).await;
+    let r = impact_results(&s, id).await;
+    assert_eq!(r.cells[0].impacts_planned, 80);
+    assert!(!r.cells[0].damage_balance.unwrap().balanced);
+    // Impacts 61–80, the next window, lose what they add: done at 80, below max.
+    run_one_adding(&s, loss, Some(0.105)).await;
+    run_one_adding(&s, loss, Some(0.105)).await;
+    assert_eq!(s.status(id).await.unwrap().state, CampaignState::Done);
+    let r = impact_results(&s, id).await;
+    assert_eq!(r.cells[0].impacts_planned, 80);
+    assert!(r.cells[0].damage_balance.unwrap().balanced);
+    assert_eq!(r.spec.unwrap()["impacts"]["until_steady"]["balanced"], true);
 }
 
 #[tokio::test]
