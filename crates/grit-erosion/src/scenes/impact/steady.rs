@@ -18,11 +18,11 @@
 //! Three windows, not two: after incubation the rate can peak for 40 impacts and then fall by
 //! half (the 16-per-Dg ladder rung, `docs/results.md`), and two windows of such a peak agree
 //! with each other. The window before them, on the rise, does not. The ends are compared too
-//! because a rate that rises by a little each window passes every adjacent pair: the seed's
-//! campaign at 45° rose 2.97, 3.33, 3.70 mg/g (1.3 and 1.3 combined standard errors a step,
-//! 2.9 end to end) and was called steady at 100 impacts by the adjacent pairs alone. With
-//! three equally spaced windows the end-to-end difference is twice the least-squares trend of
-//! the window slopes, so this is the slope-of-slopes test at twice an adjacent pair's power.
+//! because a rate that rises by a little each window passes every adjacent pair (the seed's
+//! campaign at 45°, 41–100 impacts: 2.97, 3.33, 3.70 mg/g, 1.3 combined standard errors a
+//! step and 2.9 end to end). With three equally spaced windows the end-to-end difference is
+//! twice the least-squares trend of the window slopes, so this is the slope-of-slopes test at
+//! twice an adjacent pair's power.
 //!
 //! Each cell also reports the smallest change of rate the test can see,
 //! [`SteadyState::detectable_change_rel`]: [`STEADY_SIGMAS`] combined standard errors over the
