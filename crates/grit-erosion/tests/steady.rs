@@ -36,10 +36,10 @@ fn cell(impacts: usize, samples: Vec<SampleInput>) -> CellInput {
     }
 }
 
-/// Deterministic scatter in [-1, 1] that differs between samples and impacts.
 /// Rise of the rate per impact, relative, of the slow-rise test.
 const RISE: f64 = 0.0016;
 
+/// Deterministic scatter in [-1, 1] that differs between samples and impacts.
 fn wiggle(s: u32, k: usize) -> f64 {
     (1.7 * k as f64 + 2.3 * s as f64).sin()
 }

@@ -266,15 +266,7 @@ async fn each_units_damage_added_is_stored_beside_its_masses_and_balances_the_ce
     let s = store(dir.path()).await;
     let id = s.create_campaign(&spec("21", "2"), None).await.unwrap().id;
     for _ in 0..2 {
-        let j = s.claim("w").await.unwrap().expect("a queued job");
-        let recs: Vec<ImpactRecord> = (1..=21)
-            .map(|k| {
-                let mut r = record(&j, k, 1e-3 * (1 + j.sample) as f64);
-                r.outcome.damage_added_kg = Some(2e-3 * r.grain_mass_kg);
-                r
-            })
-            .collect();
-        s.complete(j.job_id, j.lease_id, imp(&recs)).await.unwrap();
+        run_one_adding(&s, |sample, _| 1e-3 * (1 + sample) as f64, Some(2e-3)).await;
     }
     let (units, damaged): (i64, i64) =
         sqlx::query("SELECT COUNT(*), COUNT(damage_kg_m) FROM units")

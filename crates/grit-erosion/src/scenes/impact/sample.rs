@@ -355,14 +355,17 @@ impl Sample {
                 e => format!("cannot decode: {e}"),
             })
         };
+        let surface_of = |state| {
+            Particles::from_state(state)
+                .map_err(|e| SampleError::Checkpoint(format!("surface: {e}")))
+        };
         // The version comes first in every layout, and says how to read the rest.
         let (version, _) = postcard::take_from_bytes::<u32>(bytes).map_err(undecodable)?;
         let (c, rest) = match version {
             CHECKPOINT_VERSION => {
                 let (c, rest): (Checkpoint, &[u8]) =
                     postcard::take_from_bytes(bytes).map_err(undecodable)?;
-                let surface = Particles::from_state(c.surface)
-                    .map_err(|e| SampleError::Checkpoint(format!("surface: {e}")))?;
+                let surface = surface_of(c.surface)?;
                 let records = serde_json::from_str(&c.records_json).map_err(|e| {
                     SampleError::Checkpoint(format!("cannot decode records: {e}"))
                 })?;
@@ -371,8 +374,7 @@ impl Sample {
             POSTCARD_RECORDS_VERSION => {
                 let (c, rest): (CheckpointV7, &[u8]) =
                     postcard::take_from_bytes(bytes).map_err(undecodable)?;
-                let surface = Particles::from_state(c.surface)
-                    .map_err(|e| SampleError::Checkpoint(format!("surface: {e}")))?;
+                let surface = surface_of(c.surface)?;
                 ((c.params_json, c.seed, surface, records_v7(c.records)), rest)
             }
             PARTICLES_VERSION | UNCHECKED_VERSION => {
