@@ -48,8 +48,22 @@ fn worker_client(url: &str) -> Client {
 async fn two_workers_complete_a_campaign_and_match_grit_run() {
     let _g = SERIAL.lock().await;
     let dir = tempfile::tempdir().unwrap();
-    let spec = campaign(2, 2);
+    // Twenty impacts a sample (about a second a job) and both workers polling before the
+    // campaign exists: each claims within one 0.2 s poll, long before the other could finish
+    // its job and take the second one too.
+    let spec = campaign(2, 20);
     let coord = coordinator(dir.path(), "127.0.0.1:0", 30.0, "a");
+    let _w1 = worker(dir.path(), &coord.url, "w1");
+    let _w2 = worker(dir.path(), &coord.url, "w2");
+    for w in [&_w1, &_w2] {
+        wait_for(
+            Duration::from_secs(30),
+            "the worker to start polling",
+            || async { Ok::<_, ()>(w.log_text()) },
+            |log| log.contains("engine fingerprints"),
+        )
+        .await;
+    }
     let file = dir.path().join("spec.json");
     std::fs::write(&file, &spec).unwrap();
     let out = grit_cli(&coord.url, &["submit", file.to_str().unwrap()]);
@@ -60,12 +74,10 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     );
     let stdout = String::from_utf8(out.stdout).unwrap();
     let id: Uuid = stdout.lines().last().unwrap().trim().parse().unwrap();
-    let _w1 = worker(dir.path(), &coord.url, "w1");
-    let _w2 = worker(dir.path(), &coord.url, "w2");
     let c = submitter(&coord.url);
     let s = wait_done(&c, id, Duration::from_secs(120)).await;
     assert_eq!(s.impacts_done, s.impacts_total);
-    assert_eq!(s.impacts_total, 4);
+    assert_eq!(s.impacts_total, 40);
     let farm = c.results_value(id, false).await.unwrap();
     assert_eq!(farm["partial"], Value::Bool(false));
     let local = grit_run(dir.path(), &spec, "local", false);
@@ -93,8 +105,8 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
         stderr.contains("holds the results of another campaign"),
         "{stderr}"
     );
-    // The results say how they were made and whether they are steady-state rates: two
-    // impacts per sample are far too few for the last-20 window.
+    // The results say how they were made and whether they are steady-state rates: twenty
+    // impacts per sample are far too few for three last-20 windows.
     assert_eq!(farm["spec"]["samples"], 2, "{farm}");
     assert!(
         farm["spec"]["friction"].is_number(),
@@ -119,7 +131,7 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     assert_eq!(stdout, farm);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("warning: cell 60° hexagon is not at steady state: only 2 impacts"),
+        stderr.contains("warning: cell 60° hexagon is not at steady state: only 20 impacts"),
         "{stderr}"
     );
     let out = grit_cli(&coord.url, &["status", &id_text]);
