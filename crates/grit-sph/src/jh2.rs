@@ -396,10 +396,40 @@ pub fn pressure_of(laws: &Jh2Laws, rho: f64, bulking: f64, damage: f64) -> f64 {
         .max(-laws.strength.t_pa * (1.0 - damage.min(1.0)))
 }
 
+/// The least density of a JH-2 particle (kg/m³): where the tension branch of eq. 40 meets the
+/// cut −T (1 − D), ρ0 (1 + μ_cut) with K1 μ_cut + ΔP = −T (1 − D), never above ρ0. Stretched
+/// past it, rock opens voids between its fragments instead of thinning its solid
+/// (docs/jet.md#rock-targets): the pressure there is the cut's either way, and the particle's
+/// volume m/ρ stays that of its solid in every pair sum.
+#[inline]
+pub fn least_density(laws: &Jh2Laws, bulking: f64, damage: f64) -> f64 {
+    let cut = -laws.strength.t_pa * (1.0 - damage.min(1.0));
+    let mu = ((cut - bulking) / laws.eos.k1_pa).min(0.0);
+    laws.eos.rho0_kg_m3 * (1.0 + mu)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::material::Material;
+
+    #[test]
+    fn the_least_density_is_where_the_tension_is_cut() {
+        let l = Material::sandstone().jh2().expect("sandstone is JH-2");
+        for (bulking, damage) in [(0.0, 0.0), (0.0, 0.5), (3e7, 1.0), (0.0, 1.0)] {
+            let rho = least_density(&l, bulking, damage);
+            assert!(rho <= l.eos.rho0_kg_m3);
+            let cut = -l.strength.t_pa * (1.0 - damage);
+            // At the least density the EOS gives the cut, to rounding (1 mPa).
+            let p = l.eos.pressure(rho, bulking);
+            assert!(
+                (p - cut).abs() < 1e-3,
+                "{bulking} {damage}: {p} against {cut}"
+            );
+        }
+        // A fractured, unbulked particle keeps its solid's density.
+        assert_eq!(least_density(&l, 0.0, 1.0), l.eos.rho0_kg_m3);
+    }
 
     fn granite() -> (Jh2Strength, Jh2Damage, PolynomialEos) {
         let l = Material::granite().jh2().expect("granite is JH-2");

@@ -112,6 +112,7 @@ pub(crate) fn stress(ctx: &mut StepCtx<'_>, gv: &[Matrix], memo: &mut Vec<YieldM
                     }
                     Some(Strength::JohnsonHolmquist2(_)) => {
                         let laws = c.jh2.as_ref().expect("a JH-2 strength has all three laws");
+                        *rho = rho.max(jh2::least_density(laws, *bulk, *dmg));
                         let st = Jh2State {
                             sdev: s_trial,
                             eps_p: *ep,
