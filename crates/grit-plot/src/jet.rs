@@ -1,7 +1,9 @@
 //! Charts of a jet campaign's results (`docs/jet-campaigns.md`): per cell the mean crater
 //! profiles at several times (the V → U development); Cd, Cw and the mass loss against time
-//! as the mean over samples with a ±1 std band (the mass loss with its stage-3 fit); and Cd at
-//! the run's end against the jet speed, one series per combination of the other swept values.
+//! as the mean over samples with a ±1 std band (the mass loss with its stage-3 fit), and for a
+//! rock the cracks and the deepest crack below the crater; and values at the run's end against
+//! the jet speed or the abrasive mass flow, one series per combination of the other swept
+//! values (the AWJ paper's Figs. 26-27).
 //! Lengths are shown in µm, times in µs and mass loss in mg per metre of depth (the engine is
 //! 2D).
 
@@ -9,7 +11,8 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::Path;
 
-use grit_erosion::jet::aggregate::{JetCampaignResults, JetCellResult, JetMeanPoint};
+use grit_erosion::jet::aggregate::{JetCampaignResults, JetCellResult, JetMeanPoint, RockStats};
+use grit_erosion::stats::Stats;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -96,30 +99,31 @@ fn is_speed(name: &str) -> bool {
     name == "velocity_m_s" || name == "pump_pressure_mpa"
 }
 
-/// The swept values other than the jet speed: the series a cell belongs to in the
-/// speed chart.
-fn group_key(c: &JetCellResult) -> BTreeMap<String, u64> {
+/// The swept values other than the one on a chart's x axis: the series a cell belongs to.
+fn group_key(c: &JetCellResult, against: Against) -> BTreeMap<String, u64> {
     c.swept
         .iter()
-        .filter(|(k, _)| !is_speed(k))
+        .filter(|(k, _)| !against.is(k))
         .map(|(k, v)| (k.clone(), v.to_bits()))
         .collect()
 }
 
-fn group_label(c: &JetCellResult) -> String {
+fn group_label(c: &JetCellResult, against: Against) -> String {
     let parts: Vec<String> = c
         .swept
         .iter()
-        .filter(|(k, _)| !is_speed(k))
+        .filter(|(k, _)| !against.is(k))
         .map(|(k, v)| swept_text(c, k, *v))
         .collect();
-    if parts.is_empty() {
-        format!(
+    if !parts.is_empty() {
+        return parts.join(", ");
+    }
+    match against {
+        Against::Speed => format!(
             "{}, {} kg/s, {} ms",
             c.material, c.mass_flow_kg_s, c.time_ms
-        )
-    } else {
-        parts.join(", ")
+        ),
+        Against::MassFlow => format!("{}, {} m/s, {} ms", c.material, c.velocity_m_s, c.time_ms),
     }
 }
 
@@ -222,31 +226,56 @@ fn show_um(v: Option<f64>) -> String {
 
 // ------------------------------------------------------- a quantity against time
 
-/// Which series of the mean points a time chart draws.
-#[derive(Clone, Copy)]
+/// Which quantity a chart draws: against time from the mean series, against a swept value at
+/// the run's end T.
+#[derive(Clone, Copy, PartialEq)]
 enum Quantity {
     Depth,
     Width,
     MassLoss,
+    /// A rock's crack count (docs/jet.md#fractured-rock-loss-and-cracks).
+    Cracks,
+    /// How far the deepest crack reaches below the crater's bottom: the paper's bottom crack.
+    CrackDepth,
 }
 
+/// The rock quantities, drawn only when a cell has a rock target.
+const ROCK_QUANTITIES: [Quantity; 2] = [Quantity::Cracks, Quantity::CrackDepth];
+
 impl Quantity {
-    /// (mean, std) in the chart's unit.
-    fn of(self, p: &JetMeanPoint) -> (f64, Option<f64>) {
+    /// (mean, std) in the chart's unit at one point of the mean series; `None` for a rock
+    /// quantity of a metal.
+    fn of(self, p: &JetMeanPoint) -> Option<(f64, Option<f64>)> {
+        let um = |m: f64, s: Option<f64>| (m * UM_PER_M, s.map(|s| s * UM_PER_M));
         match self {
-            Quantity::Depth => (
-                p.crater_depth_m * UM_PER_M,
-                p.crater_depth_std_m.map(|s| s * UM_PER_M),
-            ),
-            Quantity::Width => (
-                p.crater_width_m * UM_PER_M,
-                p.crater_width_std_m.map(|s| s * UM_PER_M),
-            ),
-            Quantity::MassLoss => (
+            Quantity::Depth => Some(um(p.crater_depth_m, p.crater_depth_std_m)),
+            Quantity::Width => Some(um(p.crater_width_m, p.crater_width_std_m)),
+            Quantity::MassLoss => Some((
                 p.mass_loss_kg_m * MG_PER_KG,
                 p.mass_loss_std_kg_m.map(|s| s * MG_PER_KG),
-            ),
+            )),
+            Quantity::Cracks | Quantity::CrackDepth => self.at_t_rock(p.rock.as_ref()),
         }
+    }
+
+    /// (mean, std) in the chart's unit at T over the samples that reached it.
+    fn at_t(self, c: &JetCellResult) -> Option<(f64, Option<f64>)> {
+        let scaled = |s: Option<Stats>, k: f64| s.map(|s| (s.mean * k, s.std.map(|d| d * k)));
+        match self {
+            Quantity::Depth => scaled(c.crater_depth_m, UM_PER_M),
+            Quantity::Width => scaled(c.crater_width_m, UM_PER_M),
+            Quantity::MassLoss => scaled(c.mass_loss_kg_m, MG_PER_KG),
+            Quantity::Cracks | Quantity::CrackDepth => self.at_t_rock(c.rock.as_ref()),
+        }
+    }
+
+    fn at_t_rock(self, r: Option<&RockStats>) -> Option<(f64, Option<f64>)> {
+        let r = r?;
+        let (s, k) = match self {
+            Quantity::Cracks => (r.crack_count, 1.0),
+            _ => (r.crack_depth_below_crater_m, UM_PER_M),
+        };
+        Some((s.mean * k, s.std.map(|d| d * k)))
     }
 
     fn axis(self) -> &'static str {
@@ -254,22 +283,29 @@ impl Quantity {
             Quantity::Depth => "crater depth Cd (µm)",
             Quantity::Width => "crater width Cw (µm)",
             Quantity::MassLoss => "mass loss (mg per m of depth)",
+            Quantity::Cracks => "cracks in the held rock",
+            Quantity::CrackDepth => "deepest crack below the crater bottom (µm)",
         }
     }
 
-    fn title(self) -> &'static str {
+    fn name(self) -> &'static str {
         match self {
-            Quantity::Depth => "Crater depth Cd against time",
-            Quantity::Width => "Crater width Cw against time",
-            Quantity::MassLoss => "Mass loss against time",
+            Quantity::Depth => "Crater depth Cd",
+            Quantity::Width => "Crater width Cw",
+            Quantity::MassLoss => "Mass loss",
+            Quantity::Cracks => "Cracks",
+            Quantity::CrackDepth => "Deepest crack below the crater",
         }
     }
 
-    fn stem(self) -> &'static str {
+    /// The quantity's part of a chart's file name, `jet_{key}_vs_{what}`.
+    fn key(self) -> &'static str {
         match self {
-            Quantity::Depth => "jet_depth_vs_time",
-            Quantity::Width => "jet_width_vs_time",
-            Quantity::MassLoss => "jet_mass_loss_vs_time",
+            Quantity::Depth => "depth",
+            Quantity::Width => "width",
+            Quantity::MassLoss => "mass_loss",
+            Quantity::Cracks => "cracks",
+            Quantity::CrackDepth => "crack_depth",
         }
     }
 }
@@ -284,28 +320,28 @@ impl Figure for AgainstTime<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let area = with_notes(root, &self.notes)?;
         let cells = &self.results.cells;
-        let all = || cells.iter().flat_map(|c| c.mean_series.iter());
-        let x = from_zero(all().map(|p| p.t_s * US_PER_S));
-        let y = from_zero(all().map(|p| {
-            let (m, s) = self.what.of(p);
-            m + s.unwrap_or(0.0)
-        }));
+        let series = |c: &JetCellResult| -> Vec<(f64, f64, Option<f64>)> {
+            c.mean_series
+                .iter()
+                .filter_map(|p| self.what.of(p).map(|(m, s)| (p.t_s * US_PER_S, m, s)))
+                .collect()
+        };
+        let all: Vec<(f64, f64, Option<f64>)> = cells.iter().flat_map(series).collect();
+        let x = from_zero(all.iter().map(|p| p.0));
+        let y = from_zero(all.iter().map(|p| p.1 + p.2.unwrap_or(0.0)));
+        let title = format!("{} against time", self.what.name());
         let mut chart = axes(
             &area,
-            self.what.title(),
+            &title,
             (x, "simulated time (µs)"),
             (y, self.what.axis()),
         )?;
         for (i, c) in cells.iter().enumerate() {
             let col = colour(i);
-            let pts: Vec<(f64, f64, Option<f64>)> = c
-                .mean_series
-                .iter()
-                .map(|p| {
-                    let (m, s) = self.what.of(p);
-                    (p.t_s * US_PER_S, m, s)
-                })
-                .collect();
+            let pts = series(c);
+            if pts.is_empty() {
+                continue;
+            }
             if pts.iter().any(|p| p.2.is_some()) {
                 let band: Vec<(f64, f64)> = pts
                     .iter()
@@ -350,6 +386,28 @@ impl Figure for AgainstTime<'_> {
                     }))
                     .map_err(de)?;
             }
+            if ROCK_QUANTITIES.contains(&self.what) {
+                // The first grain's arrival, from the samples' first touches: what came before
+                // it is the water's alone.
+                let first: Vec<f64> = c
+                    .per_sample
+                    .iter()
+                    .filter_map(|s| s.first_grain_slice)
+                    .filter_map(|k| c.mean_series.get(k as usize - 1))
+                    .map(|p| p.t_s * US_PER_S)
+                    .collect();
+                if let Some(t) = first.iter().copied().reduce(f64::min) {
+                    let y_top = all.iter().map(|p| p.1).fold(0.0, f64::max);
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            [(t, 0.0), (t, y_top)],
+                            4,
+                            4,
+                            col.mix(0.7).stroke_width(1),
+                        ))
+                        .map_err(de)?;
+                }
+            }
         }
         crate::charts::legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
     }
@@ -363,67 +421,119 @@ fn against_time(
 ) -> Result<(), PlotError> {
     let mut notes =
         vec!["Lines: mean over the samples that reached each slice; bands: ±1 std.".to_string()];
-    if let Quantity::MassLoss = what {
-        notes.push(
-            "Dashed: the stage-3 slope over the run's late half (markers); hollow markers: not \
-             steady (docs/jet-campaigns.md)."
-                .to_string(),
-        );
-        for c in r.cells.iter().filter(|c| !c.stage3.steady) {
-            notes.push(format!(
-                "cell {}: no steady stage-3 slope: {}",
-                c.cell,
-                c.stage3.reason.split("; ").next().unwrap_or_default()
-            ));
+    match what {
+        Quantity::MassLoss => {
+            notes.push(
+                "Dashed: the stage-3 slope over the run's late half (markers); hollow markers: \
+                 not steady (docs/jet-campaigns.md)."
+                    .to_string(),
+            );
+            for c in r.cells.iter().filter(|c| !c.stage3.steady) {
+                notes.push(format!(
+                    "cell {}: no steady stage-3 slope: {}",
+                    c.cell,
+                    c.stage3.reason.split("; ").next().unwrap_or_default()
+                ));
+            }
         }
+        Quantity::Cracks | Quantity::CrackDepth => notes.push(
+            "A crack: a connected set of held rock at D ≥ 0.9 (docs/jet.md). Thin dashed \
+             verticals: the first grain touching the target, earliest over the samples."
+                .to_string(),
+        ),
+        _ => {}
     }
     let fig = AgainstTime {
         results: r,
         what,
         notes,
     };
-    report.files.extend(save(&fig, out, what.stem())?);
+    let stem = format!("jet_{}_vs_time", what.key());
+    report.files.extend(save(&fig, out, &stem)?);
     Ok(())
 }
 
-// ------------------------------------------------------------- Cd against jet speed
+// ------------------------------------------------- a quantity at T against a swept value
 
-struct DepthVsSpeed<'a> {
-    /// Series of cells with the same other swept values, each sorted by speed.
+/// The swept value a chart at T has on its x axis.
+#[derive(Clone, Copy)]
+enum Against {
+    Speed,
+    MassFlow,
+}
+
+impl Against {
+    fn x(self, c: &JetCellResult) -> f64 {
+        match self {
+            Against::Speed => c.velocity_m_s,
+            Against::MassFlow => c.mass_flow_kg_s,
+        }
+    }
+
+    /// Whether `name` is this dimension's spec name.
+    fn is(self, name: &str) -> bool {
+        match self {
+            Against::Speed => is_speed(name),
+            Against::MassFlow => name == "mass_flow_kg_s",
+        }
+    }
+
+    fn axis(self) -> &'static str {
+        match self {
+            Against::Speed => "jet speed v_jet (m/s)",
+            Against::MassFlow => "abrasive mass flow M (kg/s)",
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Against::Speed => "the jet speed",
+            Against::MassFlow => "the abrasive mass flow",
+        }
+    }
+
+    fn key(self) -> &'static str {
+        match self {
+            Against::Speed => "speed",
+            Against::MassFlow => "mass_flow",
+        }
+    }
+}
+
+struct AtTAgainst<'a> {
+    against: Against,
+    what: Quantity,
+    /// Series of cells with the same other swept values, each sorted along `against`.
     groups: Vec<Vec<&'a JetCellResult>>,
     notes: Vec<String>,
 }
 
-impl Figure for DepthVsSpeed<'_> {
+impl Figure for AtTAgainst<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let area = with_notes(root, &self.notes)?;
-        let cells = || self.groups.iter().flatten();
-        let x = padded(cells().map(|c| c.velocity_m_s));
-        let y = from_zero(cells().filter_map(|c| {
-            c.crater_depth_m
-                .map(|s| (s.mean + s.std.unwrap_or(0.0)) * UM_PER_M)
-        }));
+        let points = |g: &[&JetCellResult]| -> Vec<(f64, f64, Option<f64>)> {
+            g.iter()
+                .filter_map(|c| self.what.at_t(c).map(|(m, s)| (self.against.x(c), m, s)))
+                .collect()
+        };
+        let all: Vec<(f64, f64, Option<f64>)> =
+            self.groups.iter().flat_map(|g| points(g)).collect();
+        let x = padded(all.iter().map(|p| p.0));
+        let y = from_zero(all.iter().map(|p| p.1 + p.2.unwrap_or(0.0)));
         let cap = 0.01 * (x.end - x.start);
-        let mut chart = axes(
-            &area,
-            "Crater depth Cd at the run's end against the jet speed",
-            (x, "jet speed v_jet (m/s)"),
-            (y, "crater depth Cd at T (µm)"),
-        )?;
+        let title = format!(
+            "{} at the run's end against {}",
+            self.what.name(),
+            self.against.name()
+        );
+        let y_axis = format!("{} at T", self.what.axis());
+        let mut chart = axes(&area, &title, (x, self.against.axis()), (y, &y_axis))?;
         for (i, g) in self.groups.iter().enumerate() {
             let col = colour(i);
-            let pts: Vec<(f64, f64, Option<f64>)> = g
-                .iter()
-                .filter_map(|c| {
-                    c.crater_depth_m.map(|s| {
-                        (
-                            c.velocity_m_s,
-                            s.mean * UM_PER_M,
-                            s.std.map(|d| d * UM_PER_M),
-                        )
-                    })
-                })
-                .collect();
+            let pts = points(g);
+            if pts.is_empty() {
+                continue;
+            }
             for p in &pts {
                 if let Some(s) = p.2 {
                     chart
@@ -435,7 +545,7 @@ impl Figure for DepthVsSpeed<'_> {
             chart
                 .draw_series(LineSeries::new(pts.iter().map(|p| (p.0, p.1)), style))
                 .map_err(de)?
-                .label(group_label(g[0]))
+                .label(group_label(g[0], self.against))
                 .legend(line_key(style));
             chart
                 .draw_series(pts.iter().map(|p| Circle::new((p.0, p.1), 4, col.filled())))
@@ -445,36 +555,48 @@ impl Figure for DepthVsSpeed<'_> {
     }
 }
 
-fn depth_vs_speed(
+/// Charts of `what` at T against `against`, one series per combination of the other swept
+/// values; none when no cell has reached T.
+fn at_t_against(
     r: &JetCampaignResults,
+    against: Against,
+    what: Quantity,
     out: &Path,
     report: &mut Report,
 ) -> Result<(), PlotError> {
     let mut groups: Vec<(BTreeMap<String, u64>, Vec<&JetCellResult>)> = Vec::new();
-    for c in r.cells.iter().filter(|c| c.crater_depth_m.is_some()) {
-        let key = group_key(c);
+    for c in r.cells.iter().filter(|c| what.at_t(c).is_some()) {
+        let key = group_key(c, against);
         match groups.iter_mut().find(|(k, _)| *k == key) {
             Some((_, g)) => g.push(c),
             None => groups.push((key, vec![c])),
         }
     }
     if groups.is_empty() {
-        report
-            .notes
-            .push("no jet cell has a sample at its end time yet: no Cd against speed chart".into());
+        report.notes.push(format!(
+            "no jet cell has a sample at its end time yet: no {} against {} chart",
+            what.name(),
+            against.name()
+        ));
         return Ok(());
     }
     let mut groups: Vec<Vec<&JetCellResult>> = groups.into_iter().map(|(_, g)| g).collect();
     for g in &mut groups {
-        g.sort_by(|a, b| a.velocity_m_s.total_cmp(&b.velocity_m_s));
+        g.sort_by(|a, b| against.x(a).total_cmp(&against.x(b)));
     }
     let notes = vec![format!(
         "Mean over the samples that reached T, error bars ±1 std; one line per combination of \
          the other swept values ({} series).",
         groups.len()
     )];
-    let fig = DepthVsSpeed { groups, notes };
-    report.files.extend(save(&fig, out, "jet_depth_vs_speed")?);
+    let fig = AtTAgainst {
+        against,
+        what,
+        groups,
+        notes,
+    };
+    let stem = format!("jet_{}_vs_{}", what.key(), against.key());
+    report.files.extend(save(&fig, out, &stem)?);
     Ok(())
 }
 
@@ -490,10 +612,40 @@ pub fn plot_jet(results: &JetCampaignResults, out: &Path) -> Result<Report, Plot
         return Ok(report);
     }
     profiles(results, out, &mut report)?;
-    for what in [Quantity::Depth, Quantity::Width, Quantity::MassLoss] {
+    let rock = results
+        .cells
+        .iter()
+        .any(|c| c.mean_series.iter().any(|p| p.rock.is_some()));
+    let rock_quantities: &[Quantity] = if rock { &ROCK_QUANTITIES } else { &[] };
+    for &what in [Quantity::Depth, Quantity::Width, Quantity::MassLoss]
+        .iter()
+        .chain(rock_quantities)
+    {
         against_time(results, what, out, &mut report)?;
     }
-    depth_vs_speed(results, out, &mut report)?;
+    at_t_against(results, Against::Speed, Quantity::Depth, out, &mut report)?;
+    // The other charts at T only where their dimension is swept: the paper's trends, Cd and
+    // Cw against v_jet (Fig. 26), Cd, mass loss and the bottom crack against M (Figs. 27-28).
+    let swept = |against: Against| {
+        let mut xs: Vec<f64> = results.cells.iter().map(|c| against.x(c)).collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+        xs.len() > 1
+    };
+    if swept(Against::Speed) {
+        at_t_against(results, Against::Speed, Quantity::Width, out, &mut report)?;
+        if rock {
+            at_t_against(results, Against::Speed, Quantity::Cracks, out, &mut report)?;
+        }
+    }
+    if swept(Against::MassFlow) {
+        for &what in [Quantity::Depth, Quantity::Width, Quantity::MassLoss]
+            .iter()
+            .chain(rock_quantities)
+        {
+            at_t_against(results, Against::MassFlow, what, out, &mut report)?;
+        }
+    }
     report.notes.extend(
         results
             .unsteady_warnings()
@@ -542,6 +694,17 @@ pub fn jet_summary_table(results: &JetCampaignResults) -> String {
             )),
             if c.partial { "  (partial)" } else { "" }
         ));
+        if let Some(r) = c.rock {
+            out.push_str(&format!(
+                "      cracks at T {:.1} ± {}, their length {:.2} mm, deepest {:.0} µm below the \
+                 crater, {:.0} of the target's particles fractured\n",
+                r.crack_count.mean,
+                r.crack_count.std.map_or("–".into(), |d| format!("{d:.1}")),
+                r.crack_length_m.mean * 1e3,
+                r.crack_depth_below_crater_m.mean * UM_PER_M,
+                r.fractured_particles.mean
+            ));
+        }
     }
     out
 }

@@ -95,6 +95,11 @@ pub struct JetSampleResult {
     /// absent for a metal.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rock: Option<RockDamage>,
+    /// The first slice in which a grain touched the target; absent when none has (a pure
+    /// water jet, or grains still in flight): what the target saw before it came from the
+    /// water alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_grain_slice: Option<u32>,
 }
 
 /// One point of a cell's mean series: the mean over the samples that reached the slice.
@@ -120,6 +125,43 @@ pub struct JetMeanPoint {
     pub mass_loss_kg_m: f64,
     /// Sample standard deviation of the mass loss (kg/m); `null` below 2 samples.
     pub mass_loss_std_kg_m: Option<f64>,
+    /// A rock target's cracks and damage over the samples at this slice; absent for a metal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rock: Option<RockStats>,
+}
+
+/// A rock target's cracks and damage ([`RockDamage`], docs/jet.md#rock-targets) over the
+/// samples at one slice: mean, std and standard error of each.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RockStats {
+    /// Cracks in the held rock.
+    pub crack_count: Stats,
+    /// Their lengths summed (m).
+    pub crack_length_m: Stats,
+    /// The deepest crack tip below the crater's bottom (m): the AWJ paper's bottom crack.
+    pub crack_depth_below_crater_m: Stats,
+    /// Held rock at D ≥ 0.9 in the 2D section (m²).
+    pub damaged_area_m2: Stats,
+    /// Target particles at D = 1.
+    pub fractured_particles: Stats,
+    /// Detached rock still in the scene (kg/m).
+    pub detached_kg_m: Stats,
+}
+
+impl RockStats {
+    /// The statistics over the slices that carry rock damage; `None` when none does.
+    pub fn of(slices: &[&JetSlice]) -> Option<RockStats> {
+        let rock: Vec<RockDamage> = slices.iter().filter_map(|s| s.rock).collect();
+        let of = |f: &dyn Fn(&RockDamage) -> f64| stats(&rock.iter().map(f).collect::<Vec<_>>());
+        Some(RockStats {
+            crack_count: of(&|r| r.crack_count as f64)?,
+            crack_length_m: of(&|r| r.crack_length_m)?,
+            crack_depth_below_crater_m: of(&|r| r.crack_depth_below_crater_m)?,
+            damaged_area_m2: of(&|r| r.damaged_area_m2)?,
+            fractured_particles: of(&|r| r.fractured_particles as f64)?,
+            detached_kg_m: of(&|r| r.detached_kg_m)?,
+        })
+    }
 }
 
 /// A cell's mean surface profile at one slice: each sample's profile interpolated linearly at
@@ -218,6 +260,10 @@ pub struct JetCellResult {
     pub mass_loss_kg_m: Option<Stats>,
     /// Largest plastic strain at T.
     pub max_plastic_strain: Option<Stats>,
+    /// A rock target's cracks and damage at T; absent for a metal or before any sample
+    /// reached T.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rock: Option<RockStats>,
     /// Every reported sample at its last slice.
     pub per_sample: Vec<JetSampleResult>,
     /// The mean over samples of every slice (for charts against time).
@@ -536,6 +582,7 @@ fn mean_point(k: usize, reached: &[&JetSlice]) -> JetMeanPoint {
         half_depth_width_m: hd.map_or(0.0, |s| s.mean),
         mass_loss_kg_m: ml.map_or(0.0, |s| s.mean),
         mass_loss_std_kg_m: ml.and_then(|s| s.std),
+        rock: RockStats::of(reached),
     }
 }
 
@@ -602,6 +649,11 @@ pub fn aggregate_jet_cell(input: &JetCellInput) -> Result<JetCellResult, Aggrega
                 onset_slice: onset(&s.slices),
                 stage3_slope_kg_m_s: sample_slope(s, first, mean_series.len()),
                 rock: last.rock,
+                first_grain_slice: s
+                    .slices
+                    .iter()
+                    .find(|x| x.grain_hits.is_some_and(|h| h.count > 0))
+                    .map(|x| x.slice),
             })
         })
         .collect();
@@ -633,6 +685,7 @@ pub fn aggregate_jet_cell(input: &JetCellInput) -> Result<JetCellResult, Aggrega
         half_depth_width_m: at_t(&|s| s.half_depth_width_m),
         mass_loss_kg_m: at_t(&|s| s.sample.mass_loss_kg_m),
         max_plastic_strain: at_t(&|s| s.sample.max_plastic_strain),
+        rock: RockStats::of(&done),
         per_sample,
         mean_series,
         profiles,
@@ -674,6 +727,7 @@ mod tests {
 
     use super::*;
     use crate::jet::test_slice as slice;
+    use crate::jet::GrainHits;
 
     /// A sample of `n` slices of `dt` s losing `rate` kg/m/s after slice `onset` (from 1),
     /// plus `wiggle(k)`.
@@ -708,6 +762,55 @@ mod tests {
             planned_slices: planned,
             samples,
         }
+    }
+
+    #[test]
+    fn a_rock_cell_carries_its_cracks_per_slice_and_at_t_and_each_samples_first_grain() {
+        let rock = |cracks: usize, depth: f64| RockDamage {
+            detached_kg_m: 1e-4,
+            fractured_particles: 10 * cracks,
+            crack_count: cracks,
+            crack_length_m: 1e-3 * cracks as f64,
+            crack_depth_below_crater_m: depth,
+            damaged_area_m2: 1e-7,
+        };
+        let mut samples = vec![sample(0, 3, 1e-6, 1, 1.0), sample(1, 3, 1e-6, 1, 3.0)];
+        for (i, s) in samples.iter_mut().enumerate() {
+            for x in &mut s.slices {
+                // Sample 0: 1, 2, 3 cracks; sample 1: 3, 4, 5; the bottom crack 0.1 mm deeper
+                // each slice.
+                x.rock = Some(rock(x.slice as usize + 2 * i, 1e-4 * x.slice as f64));
+            }
+        }
+        // Sample 1's first grain lands in slice 2; sample 0's never does.
+        samples[1].slices[1].grain_hits = Some(GrainHits {
+            count: 1,
+            speed_m_s: None,
+            normal_speed_m_s: None,
+            fastest_m_s: 300.0,
+            returns: 0,
+            start_speed_sq_sum_m2_s2: 9e4,
+            steps_in_contact: 3,
+        });
+        let c = aggregate_jet_cell(&cell(samples, 3)).unwrap();
+        let first = c.mean_series[0].rock.unwrap();
+        assert_eq!(first.crack_count.mean, 2.0);
+        assert_eq!(first.crack_count.std, Some(2f64.sqrt()));
+        assert_eq!(first.crack_depth_below_crater_m.mean, 1e-4);
+        let at_t = c.rock.unwrap();
+        assert_eq!(at_t.crack_count.mean, 4.0);
+        assert_eq!(at_t.fractured_particles.mean, 40.0);
+        assert!((at_t.crack_depth_below_crater_m.mean - 3e-4).abs() < 1e-18);
+        let grains: Vec<Option<u32>> = c.per_sample.iter().map(|s| s.first_grain_slice).collect();
+        assert_eq!(grains, [None, Some(2)]);
+        // A metal keeps its results' fields: no rock anywhere.
+        let metal = aggregate_jet_cell(&cell(vec![sample(0, 3, 1e-6, 1, 1.0)], 3)).unwrap();
+        assert!(metal.rock.is_none() && metal.mean_series.iter().all(|p| p.rock.is_none()));
+        let json = serde_json::to_string(&metal).unwrap();
+        assert!(
+            !json.contains("rock") && !json.contains("first_grain"),
+            "{json}"
+        );
     }
 
     #[test]
