@@ -215,3 +215,62 @@ fn grit_plot_gathers_jet_run_files_into_a_campaign() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("scene-copy.json"), "{err}");
 }
+
+/// A rock campaign swept over the abrasive mass flow: its results carry the cracks per slice
+/// and at T and each sample's first grain, and `grit run` draws the rock's charts against
+/// time and the AWJ paper's trend charts against M (Figs. 27-28).
+#[test]
+fn a_rock_campaign_charts_its_cracks_and_the_mass_flow_trend() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("rock.json");
+    std::fs::write(
+        &spec,
+        r#"{"scene": "jet", "seed": 5, "samples": 1, "material": "sandstone",
+            "velocity_m_s": 400, "mass_flow_kg_s": [0.01, 0.04], "time_ms": 0.004,
+            "slice_ms": 0.001, "spacing_m": 1e-4, "jet_width_m": 6e-4,
+            "target_width_m": 3e-3, "target_depth_m": 8e-4, "standoff_m": 6e-4,
+            "grain_diameter_m": 2e-4}"#,
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    let out = grit(&[
+        "run",
+        spec.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--workers",
+        "1",
+        "--quiet",
+    ]);
+    succeeded(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("cracks at T"), "{stdout}");
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("results.json")).unwrap()).unwrap();
+    for cell in results["cells"].as_array().unwrap() {
+        let at_t = &cell["rock"];
+        assert!(at_t["crack_count"]["mean"].is_number(), "{cell}");
+        assert!(
+            at_t["fractured_particles"]["mean"].as_f64().unwrap() > 0.0,
+            "{cell}"
+        );
+        let series = cell["mean_series"].as_array().unwrap();
+        assert_eq!(series.len(), 4);
+        assert!(series
+            .iter()
+            .all(|p| p["rock"]["crack_count"]["mean"].is_number()));
+    }
+    for stem in [
+        "jet_cracks_vs_time",
+        "jet_crack_depth_vs_time",
+        "jet_depth_vs_mass_flow",
+        "jet_width_vs_mass_flow",
+        "jet_mass_loss_vs_mass_flow",
+        "jet_crack_depth_vs_mass_flow",
+        "jet_depth_vs_speed",
+    ] {
+        png_ok(&out_dir.join(format!("{stem}.png")));
+    }
+    // One jet speed: no width-against-speed chart.
+    assert!(!out_dir.join("jet_width_vs_speed.png").exists());
+}

@@ -301,6 +301,9 @@ fn say_cells(results: &AnyResults) {
                         f.value, f.sem
                     ))
                 );
+                if let Some(line) = c.rock_summary() {
+                    say!("          {line}");
+                }
             }
         }
     }

@@ -694,16 +694,8 @@ pub fn jet_summary_table(results: &JetCampaignResults) -> String {
             )),
             if c.partial { "  (partial)" } else { "" }
         ));
-        if let Some(r) = c.rock {
-            out.push_str(&format!(
-                "      cracks at T {:.1} ± {}, their length {:.2} mm, deepest {:.0} µm below the \
-                 crater, {:.0} of the target's particles fractured\n",
-                r.crack_count.mean,
-                r.crack_count.std.map_or("–".into(), |d| format!("{d:.1}")),
-                r.crack_length_m.mean * 1e3,
-                r.crack_depth_below_crater_m.mean * UM_PER_M,
-                r.fractured_particles.mean
-            ));
+        if let Some(line) = c.rock_summary() {
+            out.push_str(&format!("      {line}\n"));
         }
     }
     out

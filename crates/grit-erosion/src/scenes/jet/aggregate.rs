@@ -275,6 +275,21 @@ pub struct JetCellResult {
 }
 
 impl JetCellResult {
+    /// A rock cell's cracks and fracture at T in one line; `None` for a metal or before any
+    /// sample reached T.
+    pub fn rock_summary(&self) -> Option<String> {
+        let r = self.rock?;
+        Some(format!(
+            "cracks at T {:.1} ± {}, their length {:.2} mm, the deepest {:.0} µm below the crater, \
+             {:.0} of the target's particles fractured",
+            r.crack_count.mean,
+            r.crack_count.std.map_or("–".into(), |d| format!("{d:.1}")),
+            r.crack_length_m.mean * 1e3,
+            r.crack_depth_below_crater_m.mean * 1e6,
+            r.fractured_particles.mean
+        ))
+    }
+
     /// The cell's name in messages: its index and swept values.
     pub fn label(&self) -> String {
         let mut label = format!("#{}", self.cell);
