@@ -339,14 +339,14 @@ pub fn spall_speed(m: &Material) -> f64 {
 
 /// Runs a block of `nx` × `ny` particles at spacing `dx` whose halves fly apart at ±v/2 for the
 /// time a wave takes across half of it; returns (fractured particles, mean |x| of their start
-/// over dx, largest damage).
+/// over dx, largest damage, the lowest density over its least, `jh2::least_density`).
 fn spall_run(
     m: &Material,
     nx: usize,
     ny: usize,
     dx: f64,
     v: f64,
-) -> Result<(u64, f64, f64), crate::SimError> {
+) -> Result<(u64, f64, f64, f64), crate::SimError> {
     let settings = Settings::water_jet(dx, Vector::zeros());
     let (hx, hy) = (0.5 * nx as f64 * dx, 0.5 * ny as f64 * dx);
     let block = Polygon::rectangle(-hx, -hy, hx, hy);
@@ -397,7 +397,11 @@ fn spall_run(
         gone.iter().sum::<f64>() / gone.len() as f64
     };
     let dmax = p.damage.iter().copied().fold(0.0, f64::max);
-    Ok((gone.len() as u64, mean_x, dmax))
+    let l = laws(m);
+    let thinnest = (0..p.len())
+        .map(|i| p.rho[i] / crate::jh2::least_density(&l, p.bulking[i], p.damage[i]))
+        .fold(f64::INFINITY, f64::min);
+    Ok((gone.len() as u64, mean_x, dmax, thinnest))
 }
 
 /// Spall rows of one preset: below and above the spall speed.
@@ -406,8 +410,8 @@ fn spall_rows(m: &Material, nx: usize) -> Result<Vec<Row>, crate::SimError> {
     let ny = nx / 2;
     let vc = spall_speed(m);
     let (below, above) = (0.4, 2.0);
-    let (n_lo, _, d_lo) = spall_run(m, nx, ny, dx, below * vc)?;
-    let (n_hi, x_hi, _) = spall_run(m, nx, ny, dx, above * vc)?;
+    let (n_lo, _, d_lo, _) = spall_run(m, nx, ny, dx, below * vc)?;
+    let (n_hi, x_hi, _, thinnest) = spall_run(m, nx, ny, dx, above * vc)?;
     let res = format!("dx={dx} m, {nx}x{ny} particles");
     Ok(vec![
         Row {
@@ -431,11 +435,14 @@ fn spall_rows(m: &Material, nx: usize) -> Result<Vec<Row>, crate::SimError> {
             value: x_hi,
             reference: 0.0,
             error_rel: x_hi,
-            pass: n_hi > 0 && x_hi <= 2.0,
+            // Rounding of ρ0 (1 + μ) against the clamp's own: a part in 10¹².
+            pass: n_hi > 0 && x_hi <= 2.0 && thinnest >= 1.0 - 1e-12,
             expected_fail: false,
             note: format!(
                 "mean distance, in spacings, of the failed particles' start from the midplane at \
-                 {above} of the spall speed ({n_hi} failed); must fail, within 2 spacings of it"
+                 {above} of the spall speed ({n_hi} failed); must fail, within 2 spacings of it, \
+                 and no particle thinner than its least density (lowest ρ over it {thinnest:.6}; \
+                 0.99 without it)"
             ),
         },
     ])
