@@ -44,8 +44,8 @@ async fn schema5_results_keep_their_bytes() {
         (
             "jet",
             [
-                "f96cb8a907a828bfdda83de1b3465d67aef21f40d4b01fe7efe56bbc371e094d",
-                "6f3f00caadb3004e3bcfd3b410b63003f1a08e3b066f829deb38d53e0e97c4c9",
+                "fe0d774303c1e93f26ce31bc367795b2b666bda6cb5f91a625ce66c3ee669983",
+                "74b9bceb458eb315a42f06a576dd005fd86b8d74f5e883fc22aeaf89c7d0f693",
             ],
         ),
     ] {
