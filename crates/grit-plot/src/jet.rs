@@ -273,7 +273,8 @@ impl Quantity {
         let r = r?;
         let (s, k) = match self {
             Quantity::Cracks => (r.crack_count, 1.0),
-            _ => (r.crack_depth_below_crater_m, UM_PER_M),
+            Quantity::CrackDepth => (r.crack_depth_below_crater_m, UM_PER_M),
+            Quantity::Depth | Quantity::Width | Quantity::MassLoss => return None,
         };
         Some((s.mean * k, s.std.map(|d| d * k)))
     }
@@ -329,6 +330,7 @@ impl Figure for AgainstTime<'_> {
         let all: Vec<(f64, f64, Option<f64>)> = cells.iter().flat_map(series).collect();
         let x = from_zero(all.iter().map(|p| p.0));
         let y = from_zero(all.iter().map(|p| p.1 + p.2.unwrap_or(0.0)));
+        let y_top = all.iter().map(|p| p.1).fold(0.0, f64::max);
         let title = format!("{} against time", self.what.name());
         let mut chart = axes(
             &area,
@@ -397,7 +399,6 @@ impl Figure for AgainstTime<'_> {
                     .map(|p| p.t_s * US_PER_S)
                     .collect();
                 if let Some(t) = first.iter().copied().reduce(f64::min) {
-                    let y_top = all.iter().map(|p| p.1).fold(0.0, f64::max);
                     chart
                         .draw_series(DashedLineSeries::new(
                             [(t, 0.0), (t, y_top)],
