@@ -127,6 +127,34 @@ async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
 }
 
 #[tokio::test]
+async fn a_grown_cell_waits_for_the_other_cells_first_round() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = CampaignSpec::from_json(
+        r#"{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
+            "impacts": {"until_steady": {"min": 21, "max": 25, "step": 3}}, "samples": 2}"#,
+    )
+    .unwrap();
+    s.create_campaign(&sp, None).await.unwrap();
+    // Sample 0 of both cells, then cell 0's sample 1: cell 0 is complete, never steady, and
+    // grows to 24 while cell 1's sample 1 is still queued at 21.
+    let mut claimed = Vec::new();
+    for _ in 0..3 {
+        let j = run_one(&s, |_, _| 0.0).await;
+        claimed.push((j.cell, j.sample, j.impacts_planned));
+    }
+    assert_eq!(claimed, [(0, 0, 21), (1, 0, 21), (0, 1, 21)]);
+    let next = run_one(&s, |_, _| 0.0).await;
+    assert_eq!(
+        (next.cell, next.sample, next.impacts_planned),
+        (1, 1, 21),
+        "the other cell's first round before the grown cell's second"
+    );
+    let after = run_one(&s, |_, _| 0.0).await;
+    assert_eq!((after.cell, after.impacts_planned), (0, 24));
+}
+
+#[tokio::test]
 async fn a_steady_cell_is_not_extended() {
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path()).await;
