@@ -1,6 +1,7 @@
 //! Engine fingerprints: which bits an engine computes, measured rather than declared. A short
 //! canonical run of each scene (one coarse impact with contact, plasticity and damage; a few
-//! steps of a jet with water, grains and a copper target) is hashed bit for bit, so two builds
+//! steps of a jet with water, grains and a copper target, and of one on sandstone that
+//! fractures) is hashed bit for bit, so two builds
 //! that compute the same numbers share a fingerprint whatever their commit, compiler or CPU,
 //! and builds that differ anywhere in those numbers do not (grit's determinism contract,
 //! `docs/design.md`, "Rules the engine keeps").
@@ -100,27 +101,61 @@ pub fn impact_engine_of(params: &ImpactParams) -> Result<String, SceneError> {
     Ok(hex(h))
 }
 
-/// The jet engine's fingerprint: the bits [`canonical_jet`] leaves in its world and crater
-/// samples, hashed as [`impact_engine`]'s.
+/// The rock jet of the jet fingerprint: [`canonical_jet`] at 400 m/s with 0.04 kg/s of grains
+/// on sandstone (JH-2, seed paper 002's rock targets) for 3 µs: the water hammer fractures the
+/// rock and stretches fractured particles to their least density (`grit_sph::jh2`), so a change
+/// to the rock's laws moves the fingerprint as a change to the metal's does.
+pub fn canonical_rock_jet() -> JetParams {
+    JetParams {
+        material: crate::campaign::MaterialSpec(grit_sph::Material::sandstone()),
+        velocity_m_s: 400.0,
+        mass_flow_kg_s: 0.04,
+        ..canonical_jet()
+    }
+}
+
+/// The jet engine's fingerprint: the bits [`canonical_jet`] and [`canonical_rock_jet`] leave
+/// in their worlds and crater samples, hashed as [`impact_engine`]'s.
 pub fn jet_engine() -> Result<String, SceneError> {
-    let mut run = JetRun::start(&canonical_jet(), 1)?;
+    jet_engine_of(&[canonical_jet(), canonical_rock_jet()])
+}
+
+/// [`jet_engine`]'s hash of the runs of `jets`, each seeded 1, in order.
+pub fn jet_engine_of(jets: &[JetParams]) -> Result<String, SceneError> {
     let mut h = Sha256::new();
+    for p in jets {
+        let run = run_jet(p)?;
+        for c in &run.1 {
+            for x in [
+                c.t_s,
+                c.mass_loss_kg_m,
+                c.crater_depth_m,
+                c.crater_width_m,
+                c.max_plastic_strain,
+            ] {
+                h.update(x.to_bits().to_le_bytes());
+            }
+        }
+        let q = run.0.world().particles();
+        hash_particles(&mut h, q);
+        // The rock's compaction state, which the impact surface does not carry.
+        for b in &q.bulking {
+            h.update(b.to_bits().to_le_bytes());
+        }
+    }
+    Ok(hex(h))
+}
+
+/// `p` run to its end seeded 1, with the crater sample of each slice.
+fn run_jet(p: &JetParams) -> Result<(JetRun, Vec<grit_sph::crater::CraterSample>), SceneError> {
+    let mut run = JetRun::start(p, 1)?;
+    let mut samples = Vec::new();
     while run.units_done() < run.slices_total() {
         let slice = Scene::run_next(&mut run, &|| false)?
             .ok_or_else(|| SceneError::Run("the canonical jet was cancelled".into()))?;
-        let c = &slice.sample;
-        for x in [
-            c.t_s,
-            c.mass_loss_kg_m,
-            c.crater_depth_m,
-            c.crater_width_m,
-            c.max_plastic_strain,
-        ] {
-            h.update(x.to_bits().to_le_bytes());
-        }
+        samples.push(slice.sample);
     }
-    hash_particles(&mut h, run.world().particles());
-    Ok(hex(h))
+    Ok((run, samples))
 }
 
 #[cfg(test)]
@@ -142,6 +177,39 @@ mod tests {
         let slice = Scene::run_next(&mut run, &|| false).unwrap().unwrap();
         assert!(slice.sample.max_plastic_strain > 0.0, "{:?}", slice.sample);
         assert!(slice.grain_hits.is_some(), "no grain touched the target");
+    }
+
+    #[test]
+    fn the_canonical_rock_jet_fractures_and_stretches_the_rock_to_its_least_density() {
+        let p = canonical_rock_jet();
+        let laws = p.material.0.jh2().expect("sandstone is JH-2");
+        let (run, _) = run_jet(&p).unwrap();
+        let q = run.world().particles();
+        let fractured = (0..q.len()).filter(|&i| q.damage[i] >= 1.0).count();
+        let least = (0..q.len())
+            .filter(|&i| {
+                q.damage[i] > 0.0
+                    && q.rho[i] == grit_sph::jh2::least_density(&laws, q.bulking[i], q.damage[i])
+            })
+            .count();
+        assert!(fractured > 0, "no fractured rock");
+        assert!(least > 0, "no rock particle at its least density");
+    }
+
+    #[test]
+    fn a_one_ulp_change_of_the_rocks_tensile_strength_moves_the_jet_fingerprint() {
+        let base = canonical_rock_jet();
+        let mut moved = base.clone();
+        let Some(grit_sph::material::Strength::JohnsonHolmquist2(s)) =
+            moved.material.0.plasticity.as_mut()
+        else {
+            panic!("sandstone is JH-2");
+        };
+        s.t_pa = f64::from_bits(s.t_pa.to_bits() + 1);
+        assert_ne!(
+            jet_engine_of(&[base]).unwrap(),
+            jet_engine_of(&[moved]).unwrap()
+        );
     }
 
     #[test]
