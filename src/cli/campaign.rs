@@ -25,7 +25,8 @@ pub struct RunArgs {
     /// Campaign spec JSON (as in examples/); `-` reads standard input.
     pub campaign: PathBuf,
     /// Local workers (default: one per core, each with one engine thread, since samples
-    /// are independent and parallelise better than the threads inside one impact).
+    /// are independent and parallelise better than the threads inside one impact; with fewer
+    /// jobs in the campaign than cores, one per job, sharing the cores).
     #[arg(long, value_parser = crate::cli::thread_count)]
     pub workers: Option<usize>,
     /// Engine threads per worker (default: cores / workers).
@@ -190,9 +191,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     };
     let opts = EmbeddedOptions {
         out: out.clone(),
-        workers: a
-            .workers
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        workers: a.workers,
         threads_per_worker: a.threads,
         checkpoint_every: a.checkpoint_every,
         raw: a.raw,

@@ -20,8 +20,8 @@ use crate::worker::{self, Stop, WorkerOptions};
 pub struct EmbeddedOptions {
     /// Output folder: the coordinator's `grit.db` goes there.
     pub out: PathBuf,
-    /// Local workers.
-    pub workers: usize,
+    /// Local workers; `None`: [`split_cores`]'s choice for the campaign's jobs.
+    pub workers: Option<usize>,
     /// Engine threads per worker; `None` splits the machine's cores among the workers.
     pub threads_per_worker: Option<usize>,
     /// Checkpoint every this many impacts (a jet job checkpoints after every slice).
@@ -30,6 +30,23 @@ pub struct EmbeddedOptions {
     pub raw: bool,
     /// The commit this grit was built from, recorded with a new campaign.
     pub commit: Option<String>,
+}
+
+/// Local workers and engine threads per worker for a campaign of `jobs` jobs on `cores` cores, where
+/// not given: one single-thread worker per core while the jobs fill the cores, since samples
+/// run side by side scale better than the threads inside one impact (docs/performance.md,
+/// *The farm past two cores*); with fewer jobs than cores, one worker per job and the cores
+/// shared among them, so none sits idle.
+pub fn split_cores(
+    cores: usize,
+    jobs: usize,
+    workers: Option<usize>,
+    threads: Option<usize>,
+) -> (usize, usize) {
+    let cores = cores.max(1);
+    let workers = workers.unwrap_or(cores.min(jobs)).max(1);
+    let threads = threads.unwrap_or(cores / workers).max(1);
+    (workers, threads)
 }
 
 /// What the embedded run reports while it runs.
@@ -236,10 +253,11 @@ pub async fn run(
         .map_err(EmbeddedError::Start)?;
     let base = format!("http://{}", running.addr);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let workers = opts.workers.max(1);
-    let threads = opts
-        .threads_per_worker
-        .unwrap_or_else(|| (cores / workers).max(1));
+    // All the campaign's jobs, done ones included: a cell that grows queues them again.
+    let j = store.status(created.id).await?.jobs;
+    let jobs = (j.queued + j.leased + j.done + j.failed) as usize;
+    let (workers, threads) = split_cores(cores, jobs, opts.workers, opts.threads_per_worker);
+    tracing::info!(workers, threads, jobs, "local workers");
     let worker_stop = Stop::default();
     let mut handles = Vec::new();
     for i in 0..workers {
@@ -288,4 +306,28 @@ pub async fn run(
     let results = store.results_any(created.id, opts.raw).await?;
     running.stop().await;
     Ok(EmbeddedOutcome { state, results })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_cores;
+
+    #[test]
+    fn jobs_fill_the_cores_one_thread_each_and_fewer_jobs_share_them() {
+        assert_eq!(split_cores(2, 150, None, None), (2, 1));
+        assert_eq!(split_cores(16, 3, None, None), (3, 5));
+        assert_eq!(split_cores(2, 1, None, None), (1, 2));
+        assert_eq!(split_cores(16, 0, None, None), (1, 16), "no jobs");
+        assert_eq!(
+            split_cores(16, 3, Some(8), None),
+            (8, 2),
+            "--workers is kept"
+        );
+        assert_eq!(
+            split_cores(16, 3, None, Some(1)),
+            (3, 1),
+            "--threads is kept"
+        );
+        assert_eq!(split_cores(2, 150, Some(1), Some(1)), (1, 1));
+    }
 }
