@@ -1,10 +1,9 @@
 //! Engine fingerprints: which bits an engine computes, measured rather than declared. A short
 //! canonical run of each scene (one coarse impact with contact, plasticity and damage; a few
 //! steps of a jet with water, grains and a copper target, and of one on sandstone that
-//! fractures) is hashed bit for bit, so two builds
-//! that compute the same numbers share a fingerprint whatever their commit, compiler or CPU,
-//! and builds that differ anywhere in those numbers do not (grit's determinism contract,
-//! `docs/design.md`, "Rules the engine keeps").
+//! fractures) is hashed bit for bit, so two builds that compute the same numbers share a
+//! fingerprint whatever their commit, compiler or CPU, and builds that differ anywhere in those
+//! numbers do not (grit's determinism contract, `docs/design.md`, "Rules the engine keeps").
 
 use grit_sph::{Matrix, Particles, Vector};
 use sha2::{Digest, Sha256};

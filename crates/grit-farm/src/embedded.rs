@@ -32,11 +32,11 @@ pub struct EmbeddedOptions {
     pub commit: Option<String>,
 }
 
-/// Local workers and engine threads per worker for a campaign of `jobs` jobs on `cores` cores, where
-/// not given: one single-thread worker per core while the jobs fill the cores, since samples
-/// run side by side scale better than the threads inside one impact (docs/performance.md,
-/// *The farm past two cores*); with fewer jobs than cores, one worker per job and the cores
-/// shared among them, so none sits idle.
+/// Local workers and engine threads per worker for a campaign of `jobs` jobs on `cores`
+/// cores, where not given: one single-thread worker per core while the jobs fill the cores,
+/// since samples side by side scale better than the threads inside one impact
+/// (docs/performance.md, *The farm past two cores*); with fewer jobs than cores, one worker
+/// per job and the cores shared among them, so none sits idle.
 pub fn split_cores(
     cores: usize,
     jobs: usize,
