@@ -40,6 +40,10 @@ pub struct Ratio {
     pub within_goal: Option<bool>,
     /// Whether both cells passed the steady-state check (`null`: one was not checked).
     pub steady: Option<bool>,
+    /// Whether both cells' last window is balanced, their loss paying for the damage added
+    /// (`damage_balance`; `null`: one has no balance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub balanced: Option<bool>,
 }
 
 /// One row of the angle table: a cell normalised by its shape's 45° cell.
@@ -87,6 +91,9 @@ pub struct FitRow {
     pub within_goal: bool,
     /// Whether the cell passed the steady-state check (`null`: not checked).
     pub steady: Option<bool>,
+    /// Whether the cell's last window is balanced (`damage_balance`; `null`: no balance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub balanced: Option<bool>,
 }
 
 /// One shape's angles against Oka's g(α) (eq. 35) with one scale fitted to all of them by
@@ -144,6 +151,9 @@ pub struct RepeatRow {
     pub erosion_sem: Option<f64>,
     /// Whether the cell passed the steady-state check (`null`: not checked).
     pub steady: Option<bool>,
+    /// Whether the cell's last window is balanced (`damage_balance`; `null`: no balance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub balanced: Option<bool>,
     /// (erosion − the first file's) / √(s.e.² + the first file's s.e.²): independent samples.
     pub z_vs_first: Option<f64>,
 }
@@ -217,6 +227,7 @@ pub fn on_window(
         c.erosion_std = None;
         c.erosion_sem_rel = None;
         c.steady_state = None;
+        c.damage_balance = None;
     }
     out.steady = None;
     Ok((out, notes))
@@ -249,6 +260,7 @@ pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell>
                         erosion: same.erosion_mean,
                         erosion_sem: same.erosion_sem,
                         steady: steady(same),
+                        balanced: balanced(same),
                         z_vs_first: match (c.erosion_mean, c.erosion_sem) {
                             (Some(a), Some(sa)) => match (same.erosion_mean, same.erosion_sem) {
                                 (Some(b), Some(sb)) if sa.hypot(sb) > 0.0 => {
@@ -283,6 +295,15 @@ fn steady(c: &CellResult) -> Option<bool> {
     c.steady_state.as_ref().map(|s| s.steady)
 }
 
+fn balanced(c: &CellResult) -> Option<bool> {
+    c.damage_balance.as_ref().map(|b| b.balanced)
+}
+
+/// Both cells' flag when both have one.
+fn both(a: Option<bool>, b: Option<bool>) -> Option<bool> {
+    a.zip(b).map(|(a, b)| a && b)
+}
+
 fn ratio(num: &CellResult, den: &CellResult, reference: f64, tolerance: f64) -> Ratio {
     let value = match (num.erosion_mean, den.erosion_mean) {
         (Some(a), Some(b)) if b != 0.0 => Some(a / b),
@@ -313,10 +334,8 @@ fn ratio(num: &CellResult, den: &CellResult, reference: f64, tolerance: f64) -> 
             _ => None,
         },
         within_goal: deviation.map(|d| d.abs() <= tolerance),
-        steady: match (steady(num), steady(den)) {
-            (Some(a), Some(b)) => Some(a && b),
-            _ => None,
-        },
+        steady: both(steady(num), steady(den)),
+        balanced: both(balanced(num), balanced(den)),
     }
 }
 
@@ -421,6 +440,7 @@ fn oka_fit(shape: &str, cells: &[&CellResult], g: impl Fn(f64) -> f64) -> Option
                 z: (e - oka) / s,
                 within_goal: deviation.abs() <= ANGLE_TOLERANCE,
                 steady: steady(c),
+                balanced: balanced(c),
             }
         })
         .collect();
@@ -441,6 +461,16 @@ fn yes_no(v: Option<bool>, yes: &str, no: &str) -> String {
     v.map_or("not checked".into(), |b| (if b { yes } else { no }).into())
 }
 
+/// A cell's verdicts: the steady rule's, then, for a steady cell with a damage balance,
+/// whether its loss pays for the damage added (docs/erosion.md, *The damage balance*).
+fn verdict(steady: Option<bool>, balanced: Option<bool>) -> String {
+    match (steady, balanced) {
+        (Some(true), Some(true)) => "steady, balanced".into(),
+        (Some(true), Some(false)) => "steady, **unbalanced**".into(),
+        (s, _) => yes_no(s, "steady", "**unsteady**"),
+    }
+}
+
 /// A ratio's table cells: value ± s.e., reference, deviation, z, goal and steadiness.
 fn ratio_cells(r: &Ratio) -> [String; 6] {
     [
@@ -450,7 +480,7 @@ fn ratio_cells(r: &Ratio) -> [String; 6] {
             .map_or("–".into(), |d| format!("{:+.0} %", 100.0 * d)),
         num(r.z, 1),
         yes_no(r.within_goal, "yes", "**no**"),
-        yes_no(r.steady, "steady", "**unsteady**"),
+        verdict(r.steady, r.balanced),
     ]
 }
 
@@ -538,7 +568,7 @@ pub fn markdown(c: &Comparison) -> String {
                     format!("{:+.0} %", 100.0 * r.deviation),
                     format!("{:.1}", r.z),
                     yes_no(Some(r.within_goal), "yes", "**no**"),
-                    yes_no(r.steady, "steady", "**unsteady**"),
+                    verdict(r.steady, r.balanced),
                 ]
             }),
         );
@@ -597,7 +627,7 @@ pub fn markdown(c: &Comparison) -> String {
                         num(w.erosion_sem.map(|e| 1e3 * e), 2)
                     ),
                     num(w.z_vs_first, 1),
-                    yes_no(w.steady, "steady", "**unsteady**"),
+                    verdict(w.steady, w.balanced),
                 ]
             }),
         );
@@ -647,6 +677,49 @@ mod tests {
             engine: None,
             commit: None,
         }
+    }
+
+    #[test]
+    fn a_steady_cells_balance_is_its_verdicts_second_half() {
+        let with_balance = |angle, balanced| {
+            let mut c = cell("hexagon", angle, 1e-3, 1e-4, true);
+            c.damage_balance = Some(crate::impact::balance::DamageBalance {
+                points: 20,
+                samples: 10,
+                loss_rate: 1e-3,
+                loss_rate_sem: 1e-4,
+                damage_rate: 1.2e-3,
+                damage_rate_sem: 1e-4,
+                difference_sem: 1e-4,
+                ratio: Some(0.83),
+                balanced,
+                detectable_rel: Some(0.17),
+            });
+            c
+        };
+        let cells = vec![
+            with_balance(45.0, true),
+            with_balance(60.0, false),
+            cell("hexagon", 75.0, 1e-3, 1e-4, true),
+            cell("hexagon", 90.0, 1e-3, 1e-4, false),
+        ];
+        let c = compare(&results(cells));
+        let flags: Vec<_> = c.angles.iter().map(|a| a.ratio.balanced).collect();
+        assert_eq!(flags, [Some(true), Some(false), None, None]);
+        let md = markdown(&c);
+        assert!(
+            md.contains(
+                "| 45° | 1.00 ± 0.10 | 1.00 ± 0.00 | 1.00 | +0 % | – | yes | steady, balanced |"
+            ),
+            "{md}"
+        );
+        assert!(md.contains("| steady, **unbalanced** |"), "{md}");
+        assert!(md.contains("| **unsteady** |"), "{md}");
+        let fit = &c.oka_fits[0].rows;
+        assert_eq!(
+            fit.iter().map(|r| r.balanced).collect::<Vec<_>>(),
+            [Some(true), Some(false), None, None]
+        );
     }
 
     #[test]
