@@ -123,8 +123,8 @@ pub fn jet_engine() -> Result<String, SceneError> {
 pub fn jet_engine_of(jets: &[JetParams]) -> Result<String, SceneError> {
     let mut h = Sha256::new();
     for p in jets {
-        let run = run_jet(p)?;
-        for c in &run.1 {
+        let (run, samples) = run_jet(p)?;
+        for c in &samples {
             for x in [
                 c.t_s,
                 c.mass_loss_kg_m,
@@ -135,7 +135,7 @@ pub fn jet_engine_of(jets: &[JetParams]) -> Result<String, SceneError> {
                 h.update(x.to_bits().to_le_bytes());
             }
         }
-        let q = run.0.world().particles();
+        let q = run.world().particles();
         hash_particles(&mut h, q);
         // The rock's compaction state, which the impact surface does not carry.
         for b in &q.bulking {
