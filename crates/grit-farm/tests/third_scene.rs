@@ -163,6 +163,7 @@ fn plan(units: u32) -> CampaignPlan {
         units_total: jobs.len() as u64 * units as u64,
         cells,
         jobs,
+        queue: grit_erosion::campaign::QueueOrder::Rounds,
     }
 }
 

@@ -8,7 +8,8 @@ use serde::{Serialize, Serializer};
 use serde_json::Value;
 
 use super::{
-    err, job_seed, CampaignSpec, JetCampaignSpec, Scene, SpecError, TargetSem, UntilSteady,
+    err, job_seed, CampaignSpec, JetCampaignSpec, QueueOrder, Scene, SpecError, TargetSem,
+    UntilSteady,
 };
 use crate::Scene as _;
 
@@ -111,17 +112,20 @@ pub struct CampaignPlan {
     pub units_total: u64,
     /// Every job as (cell, sample, units planned, seed), cell by cell.
     pub jobs: Vec<(u32, u32, u32, u64)>,
+    /// The order a farm hands out the jobs.
+    pub queue: QueueOrder,
 }
 
 impl AnySpec {
     /// The campaign's cells and jobs, validating the spec once.
     pub fn plan(&self) -> Result<CampaignPlan, SpecError> {
-        let (kind, seed, samples, target_sem, cells) = match self {
+        let (kind, seed, samples, target_sem, queue, cells) = match self {
             AnySpec::Impact(s) => (
                 crate::Sample::KIND,
                 s.seed,
                 s.samples.initial(),
                 s.samples.target_sem(),
+                s.queue,
                 s.cells()?
                     .into_iter()
                     .map(|c| PlannedCell {
@@ -140,6 +144,7 @@ impl AnySpec {
                 s.seed,
                 s.samples,
                 None,
+                QueueOrder::Rounds,
                 s.cells()?
                     .into_iter()
                     .map(|c| PlannedCell {
@@ -167,6 +172,7 @@ impl AnySpec {
             units_total: jobs.iter().map(|j| j.2 as u64).sum(),
             cells,
             jobs,
+            queue,
         })
     }
 }

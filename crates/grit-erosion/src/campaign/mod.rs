@@ -26,7 +26,7 @@ mod any;
 pub(crate) mod json;
 mod plan;
 mod stored;
-pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts};
+pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts, QueueOrder};
 pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, Scene};
 pub use any::{AnySpec, CampaignPlan, PlannedCell};
 pub use plan::{

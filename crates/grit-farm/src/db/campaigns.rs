@@ -130,7 +130,7 @@ impl Store {
             .execute(&mut *tx)
             .await?;
         }
-        insert_queued_jobs(&mut tx, &id.to_string(), seq, &plan.jobs, now).await?;
+        insert_queued_jobs(&mut tx, &id.to_string(), seq, &plan.jobs, plan.queue, now).await?;
         tx.commit().await?;
         tracing::info!(campaign = %id, scene = plan.kind, jobs = jobs_total,
             units_total = plan.units_total, engine, "campaign created");

@@ -6,7 +6,9 @@
 
 use std::collections::BTreeMap;
 
-use grit_erosion::campaign::{job_seed, NextStep, StoredCell, TargetSem, UnitMasses, UntilSteady};
+use grit_erosion::campaign::{
+    job_seed, NextStep, QueueOrder, StoredCell, TargetSem, UnitMasses, UntilSteady,
+};
 use serde::Deserialize;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
@@ -77,10 +79,13 @@ impl Store {
     }
 }
 
-/// What a farm reads of any stored spec: the campaign's seed, which every job's derives from.
+/// What a farm reads of any stored spec: the campaign's seed, which every job's derives from,
+/// and the order its jobs are handed out in.
 #[derive(Deserialize)]
 struct Seeded {
     seed: u64,
+    #[serde(default)]
+    queue: QueueOrder,
 }
 
 /// After a job of cell `plan`, one with growth rules, completed: once every job of the cell
@@ -163,13 +168,12 @@ pub(super) async fn settle_cell(
                 .fetch_one(&mut **tx)
                 .await?;
             let seq: i64 = r.get(0);
-            let seed = serde_json::from_str::<Seeded>(r.get::<&str, _>(1))
-                .map_err(|e| Error::Internal(format!("stored spec's seed: {e}")))?
-                .seed;
+            let Seeded { seed, queue } = serde_json::from_str(r.get::<&str, _>(1))
+                .map_err(|e| Error::Internal(format!("stored spec's seed: {e}")))?;
             let jobs: Vec<NewJob> = (plan.samples..to)
                 .map(|s| (plan.index, s, plan.units, job_seed(seed, plan.index, s)))
                 .collect();
-            insert_queued_jobs(tx, campaign, seq, &jobs, now).await?;
+            insert_queued_jobs(tx, campaign, seq, &jobs, queue, now).await?;
             grow_cell(
                 tx,
                 campaign,

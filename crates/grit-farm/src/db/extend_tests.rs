@@ -155,6 +155,69 @@ async fn a_grown_cell_waits_for_the_other_cells_first_round() {
 }
 
 #[tokio::test]
+async fn a_campaign_queued_by_cell_finishes_one_cell_before_the_next_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = CampaignSpec::from_json(
+        r#"{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
+            "impacts": {"until_steady": {"min": 21, "max": 24, "step": 3}}, "samples": 2,
+            "queue": "cells"}"#,
+    )
+    .unwrap();
+    s.create_campaign(&sp, None).await.unwrap();
+    // Never steady: cell 0 grows to its max before cell 1 gets a job; in round order (the
+    // test above) cell 1's first round would come second.
+    let mut claimed = Vec::new();
+    for _ in 0..8 {
+        let j = run_one(&s, |_, _| 0.0).await;
+        claimed.push((j.cell, j.sample, j.impacts_planned));
+    }
+    assert_eq!(
+        claimed,
+        [
+            (0, 0, 21),
+            (0, 1, 21),
+            (0, 0, 24),
+            (0, 1, 24),
+            (1, 0, 21),
+            (1, 1, 21),
+            (1, 0, 24),
+            (1, 1, 24)
+        ]
+    );
+    assert!(s.claim("w").await.unwrap().is_none());
+}
+
+#[tokio::test]
+async fn samples_added_to_a_cell_queued_by_cell_come_before_the_next_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let sp = CampaignSpec::from_json(
+        r#"{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
+            "impacts": 21, "samples": {"target_sem_rel": 0.01, "min": 2, "max": 3},
+            "queue": "cells"}"#,
+    )
+    .unwrap();
+    s.create_campaign(&sp, None).await.unwrap();
+    // Two samples far apart: the error bar is wide, so each cell gets a third sample, which
+    // is handed out before the next cell's first.
+    let mut claimed = Vec::new();
+    for _ in 0..6 {
+        let j = run_one(&s, |sample, _| 0.1 + 0.2 * sample as f64).await;
+        claimed.push((j.cell, j.sample));
+    }
+    assert_eq!(claimed, [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1), (1, 2)]);
+    // An added sample keeps its cell's rank, so that with several workers a later cell's
+    // added samples cannot overtake an earlier cell's growth.
+    let ranks: Vec<(i64, i64)> =
+        sqlx::query_as("SELECT cell_index, queue_rank FROM jobs ORDER BY cell_index, sample_index")
+            .fetch_all(&s.read)
+            .await
+            .unwrap();
+    assert_eq!(ranks, [(0, 0), (0, 0), (0, 0), (1, 1), (1, 1), (1, 1)]);
+}
+
+#[tokio::test]
 async fn a_steady_cell_is_not_extended() {
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path()).await;

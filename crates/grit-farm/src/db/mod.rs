@@ -10,7 +10,7 @@ use std::path::Path;
 use std::str::FromStr;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use grit_erosion::campaign::{CellRecords, StoredCell};
+use grit_erosion::campaign::{CellRecords, QueueOrder, StoredCell};
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
 };
@@ -321,24 +321,31 @@ pub(crate) async fn insert_campaign(
 /// A job row to insert as queued: (cell, sample, impacts planned, seed).
 pub(crate) type NewJob = (u32, u32, u32, u64);
 
-/// Inserts `jobs` of `campaign` (rowid `seq`) as queued. Multi-row inserts keep a campaign of
-/// many thousand jobs to a few statements; 400 rows × 8 values stays under SQLite's limit on
-/// bound variables.
+/// Inserts `jobs` of `campaign` (rowid `seq`) as queued, ranked in the claim order `queue`
+/// asks for (migrations/0012_queue_by_cell.sql). Multi-row inserts keep a campaign of many
+/// thousand jobs to a few statements; 400 rows × 9 values stays under SQLite's limit on bound
+/// variables.
 pub(crate) async fn insert_queued_jobs(
     tx: &mut Transaction<'static, Sqlite>,
     campaign: &str,
     seq: i64,
     jobs: &[NewJob],
+    queue: QueueOrder,
     now: i64,
 ) -> Result<()> {
     for chunk in jobs.chunks(400) {
         let mut qb = sqlx::QueryBuilder::<Sqlite>::new(
-            "INSERT INTO jobs (campaign_id, campaign_seq, cell_index, sample_index, seed,
-                               units_planned, state, updated_ms) ",
+            "INSERT INTO jobs (campaign_id, campaign_seq, queue_rank, cell_index, sample_index,
+                               seed, units_planned, state, updated_ms) ",
         );
         qb.push_values(chunk, |mut b, (cell, sample, impacts, seed)| {
+            let rank = match queue {
+                QueueOrder::Rounds => 0,
+                QueueOrder::Cells => *cell as i64,
+            };
             b.push_bind(campaign)
                 .push_bind(seq)
+                .push_bind(rank)
                 .push_bind(*cell as i64)
                 .push_bind(*sample as i64)
                 .push_bind(*seed as i64)

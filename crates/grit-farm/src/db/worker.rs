@@ -386,9 +386,10 @@ pub(super) async fn apply_claim(
     let lease = Uuid::new_v4();
     let expires = now + lease_ttl.as_millis() as i64;
     // The first queued job of a campaign that is unpinned or pinned to the worker's
-    // fingerprint for its scene; the lease records that fingerprint for the units. Fewest
-    // units planned first: a grown cell's samples wait for the other cells' first round
-    // (migrations/0011_queue_by_round.sql).
+    // fingerprint for its scene; the lease records that fingerprint for the units. Within a
+    // campaign, a cell-by-cell campaign's lowest cell first, then fewest units planned first:
+    // a grown cell's samples wait for the other cells' first round
+    // (migrations/0011_queue_by_round.sql, 0012_queue_by_cell.sql).
     let Some(r) = sqlx::query(
         "UPDATE jobs SET state = 'leased', lease_id = ?1, worker = ?2, lease_expires_ms = ?3,
                          updated_ms = ?4,
@@ -400,7 +401,8 @@ pub(super) async fn apply_claim(
                        AND (c.engine IS NULL
                             OR c.engine = coalesce(json_extract(?5, '$.\"' || c.scene || '\"'),
                                                    json_extract(?5, '$.\"*\"')))
-                     ORDER BY j.campaign_seq, j.units_planned, j.sample_index, j.cell_index LIMIT 1)
+                     ORDER BY j.campaign_seq, j.queue_rank, j.units_planned, j.sample_index,
+                              j.cell_index LIMIT 1)
          RETURNING id, campaign_id, cell_index, sample_index, seed, units_planned, units_done",
     )
     .bind(lease.to_string())

@@ -166,6 +166,29 @@ pub struct CampaignSpec {
     /// absent, a farm pins the campaign to its coordinator's own.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub engine: Option<String>,
+    /// The order a farm hands out the jobs ([`QueueOrder`]); absent, by rounds.
+    #[serde(skip_serializing_if = "QueueOrder::is_rounds")]
+    pub queue: QueueOrder,
+}
+
+/// The order a farm hands out a campaign's jobs (`docs/design.md`, *Claim*).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum QueueOrder {
+    /// Every cell's first round before any cell's growth: all cells report early.
+    #[default]
+    Rounds,
+    /// One cell to its end before the next, in expansion order: finished cells come one by
+    /// one, and only one cell's samples hold checkpoints at a time.
+    Cells,
+}
+
+impl QueueOrder {
+    /// Whether this is the default order, which a stored spec leaves out so that specs
+    /// written before the field existed keep their idempotency key.
+    pub fn is_rounds(&self) -> bool {
+        *self == QueueOrder::Rounds
+    }
 }
 
 impl Default for CampaignSpec {
@@ -190,6 +213,7 @@ impl Default for CampaignSpec {
             settle_fraction: p.settle_fraction,
             allow_short_samples: false,
             engine: None,
+            queue: QueueOrder::Rounds,
         }
     }
 }
@@ -760,6 +784,23 @@ mod tests {
         assert_eq!(
             serde_json::to_string(&s).unwrap(),
             r#"{"name":null,"seed":0,"angles_deg":[45.0],"shapes":["octagon","hexagon","square","rectangle"],"samples":25,"impacts":{"45":30},"velocity_m_s":[80.0,100.0],"grain":{"diameter_m":0.00025,"density_kg_m3":2500.0},"spacing_m":8e-6,"distribution_range_dg":1.0,"material":"aisi304","friction":0.5,"surface_width_dg":4.0,"surface_depth_dg":1.5,"settle_fraction":0.02,"allow_short_samples":false}"#
+        );
+    }
+
+    #[test]
+    fn the_queue_order_is_named_and_only_a_cell_order_is_stored() {
+        let cells = parse(r#"{"queue": "cells"}"#).unwrap();
+        assert_eq!(cells.queue, QueueOrder::Cells);
+        assert!(serde_json::to_string(&cells)
+            .unwrap()
+            .contains(r#""queue":"cells""#));
+        let rounds = parse(r#"{"queue": "rounds"}"#).unwrap();
+        assert_eq!(rounds, CampaignSpec::default());
+        assert!(!serde_json::to_string(&rounds).unwrap().contains("queue"));
+        assert!(parse(r#"{"queue": "sideways"}"#).is_err());
+        assert_eq!(
+            parse(r#"{"queue": "sideways"}"#).unwrap_err().field,
+            "queue"
         );
     }
 
