@@ -20,6 +20,26 @@ async fn store(dir: &Path) -> Store {
         .unwrap()
 }
 
+/// The cells 90° and 45° of one shape, with `fields` added to the spec.
+fn two_cells(fields: &str) -> CampaignSpec {
+    CampaignSpec::from_json(&format!(
+        r#"{{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
+            {fields}}}"#
+    ))
+    .unwrap()
+}
+
+/// Runs the next `n` jobs as claimed, each losing `loss(sample, k)`: their (cell, sample,
+/// impacts planned) in claim order.
+async fn claim_order(s: &Store, n: usize, loss: impl Fn(u32, u32) -> f64) -> Vec<(u32, u32, u32)> {
+    let mut claimed = Vec::new();
+    for _ in 0..n {
+        let j = run_one(s, &loss).await;
+        claimed.push((j.cell, j.sample, j.impacts_planned));
+    }
+    claimed
+}
+
 fn spec(impacts: &str, samples: &str) -> CampaignSpec {
     CampaignSpec::from_json(&format!(
         r#"{{"seed": 5, "angles_deg": [90], "shapes": ["hexagon"], "spacing_m": 25e-6,
@@ -130,19 +150,13 @@ async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
 async fn a_grown_cell_waits_for_the_other_cells_first_round() {
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path()).await;
-    let sp = CampaignSpec::from_json(
-        r#"{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
-            "impacts": {"until_steady": {"min": 21, "max": 25, "step": 3}}, "samples": 2}"#,
-    )
-    .unwrap();
+    let sp = two_cells(
+        r#""impacts": {"until_steady": {"min": 21, "max": 25, "step": 3}}, "samples": 2"#,
+    );
     s.create_campaign(&sp, None).await.unwrap();
     // Sample 0 of both cells, then cell 0's sample 1: cell 0 is complete, never steady, and
     // grows to 24 while cell 1's sample 1 is still queued at 21.
-    let mut claimed = Vec::new();
-    for _ in 0..3 {
-        let j = run_one(&s, |_, _| 0.0).await;
-        claimed.push((j.cell, j.sample, j.impacts_planned));
-    }
+    let claimed = claim_order(&s, 3, |_, _| 0.0).await;
     assert_eq!(claimed, [(0, 0, 21), (1, 0, 21), (0, 1, 21)]);
     let next = run_one(&s, |_, _| 0.0).await;
     assert_eq!(
@@ -158,20 +172,14 @@ async fn a_grown_cell_waits_for_the_other_cells_first_round() {
 async fn a_campaign_queued_by_cell_finishes_one_cell_before_the_next_starts() {
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path()).await;
-    let sp = CampaignSpec::from_json(
-        r#"{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
-            "impacts": {"until_steady": {"min": 21, "max": 24, "step": 3}}, "samples": 2,
-            "queue": "cells"}"#,
-    )
-    .unwrap();
+    let sp = two_cells(
+        r#""impacts": {"until_steady": {"min": 21, "max": 24, "step": 3}}, "samples": 2,
+            "queue": "cells""#,
+    );
     s.create_campaign(&sp, None).await.unwrap();
     // Never steady: cell 0 grows to its max before cell 1 gets a job; in round order (the
     // test above) cell 1's first round would come second.
-    let mut claimed = Vec::new();
-    for _ in 0..8 {
-        let j = run_one(&s, |_, _| 0.0).await;
-        claimed.push((j.cell, j.sample, j.impacts_planned));
-    }
+    let claimed = claim_order(&s, 8, |_, _| 0.0).await;
     assert_eq!(
         claimed,
         [
@@ -192,21 +200,16 @@ async fn a_campaign_queued_by_cell_finishes_one_cell_before_the_next_starts() {
 async fn samples_added_to_a_cell_queued_by_cell_come_before_the_next_cell() {
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path()).await;
-    let sp = CampaignSpec::from_json(
-        r#"{"seed": 5, "angles_deg": [90, 45], "shapes": ["hexagon"], "spacing_m": 25e-6,
-            "impacts": 21, "samples": {"target_sem_rel": 0.01, "min": 2, "max": 3},
-            "queue": "cells"}"#,
-    )
-    .unwrap();
+    let sp = two_cells(
+        r#""impacts": 21, "samples": {"target_sem_rel": 0.01, "min": 2, "max": 3},
+            "queue": "cells""#,
+    );
     s.create_campaign(&sp, None).await.unwrap();
     // Two samples far apart: the error bar is wide, so each cell gets a third sample, which
     // is handed out before the next cell's first.
-    let mut claimed = Vec::new();
-    for _ in 0..6 {
-        let j = run_one(&s, |sample, _| 0.1 + 0.2 * sample as f64).await;
-        claimed.push((j.cell, j.sample));
-    }
-    assert_eq!(claimed, [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1), (1, 2)]);
+    let claimed = claim_order(&s, 6, |sample, _| 0.1 + 0.2 * sample as f64).await;
+    let samples: Vec<(u32, u32)> = claimed.iter().map(|c| (c.0, c.1)).collect();
+    assert_eq!(samples, [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1), (1, 2)]);
     // An added sample keeps its cell's rank, so that with several workers a later cell's
     // added samples cannot overtake an earlier cell's growth.
     let ranks: Vec<(i64, i64)> =
