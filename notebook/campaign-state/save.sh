@@ -11,7 +11,7 @@ db=$1
 out=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-sqlite3 "file:$db?mode=ro" ".backup $tmp/copy.db"
+sqlite3 "file:$db?mode=ro" "VACUUM INTO '$tmp/copy.db'"
 sqlite3 "$tmp/copy.db" "DELETE FROM checkpoints;"
 sqlite3 "$tmp/copy.db" ".dump" > "$out.tmp"
 mv "$out.tmp" "$out"
