@@ -169,7 +169,7 @@ pub(super) async fn settle_cell(
                 .await?;
             let seq: i64 = r.get(0);
             let Seeded { seed, queue } = serde_json::from_str(r.get::<&str, _>(1))
-                .map_err(|e| Error::Internal(format!("stored spec's seed: {e}")))?;
+                .map_err(|e| Error::Internal(format!("stored spec's seed or queue: {e}")))?;
             let jobs: Vec<NewJob> = (plan.samples..to)
                 .map(|s| (plan.index, s, plan.units, job_seed(seed, plan.index, s)))
                 .collect();
