@@ -32,9 +32,9 @@ pub const BALANCE_POINTS: usize = SLOPE_WINDOW;
 /// mean, that still counts as a balance (about a 95 % two-sided test).
 pub const BALANCE_SIGMAS: f64 = 2.0;
 
-/// Smallest loss / damage added that counts as a balance: the loss, which the stationary rate
-/// exceeds by the damage still stored, is then within 10 % of it, the tolerance the resolution
-/// ladder is judged by (`docs/erosion.md`, *The damage balance*).
+/// Smallest loss / damage added that counts as a balance: the stationary rate lies between the
+/// two, so the loss is then within 10 % of it, the tolerance the resolution ladder is judged by
+/// (`docs/erosion.md`, *The damage balance*).
 pub const BALANCE_MIN_RATIO: f64 = 0.9;
 
 /// Loss against damage added over a cell's last window (seed paper eq. 19: a particle leaves
