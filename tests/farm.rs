@@ -747,6 +747,29 @@ async fn until_steady_extends_samples_bit_for_bit() {
         .collect();
     assert_bitwise_equal(&head, &fixed);
 
+    // Capped at 23, then run again with the cap raised to 25: the cell runs on from its
+    // samples' states at 23 to the bits of the cap of 25 from the start. The old spec is then
+    // another campaign.
+    let capped = spec.replace(r#""max": 25"#, r#""max": 23"#);
+    let at_23 = grit_run(dir.path(), &capped, "raised", true);
+    assert_eq!(at_23["cells"][0]["impacts_planned"], 23);
+    let raised = grit_run(dir.path(), &spec, "raised", true);
+    assert_eq!(raised["cells"][0]["steady_state"], cell["steady_state"]);
+    assert_bitwise_equal(&raw_series(&raised), &local);
+    std::fs::write(dir.path().join("capped.json"), &capped).unwrap();
+    let out = Command::new(GRIT)
+        .args(["run", "--quiet", "--out"])
+        .arg(dir.path().join("raised"))
+        .arg(dir.path().join("capped.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("until_steady.max may only be raised, from 25 (got 23)"),
+        "{stderr}"
+    );
+
     // Served, two workers, one killed with -9 while the cell grows: the same records.
     let coord = coordinator(dir.path(), "127.0.0.1:0", 2.0, "a");
     let c = submitter(&coord.url);

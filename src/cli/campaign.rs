@@ -224,6 +224,8 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
                 );
             }
         }
+        // A hidden bar (no terminal, --quiet) prints nothing of its own.
+        RunEvent::Note(line) if bar.is_hidden() => eprintln!("{line}"),
         RunEvent::Note(line) => bar.println(line),
     })
     .await?;

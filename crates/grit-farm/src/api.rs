@@ -438,8 +438,9 @@ pub struct ClaimedJob {
     /// The scene's parameters (`ImpactParams` for `impact`, `JetParams` for `jet`).
     #[schema(value_type = Object)]
     pub params: Value,
-    /// Whether the job's cell may later ask for more impacts (`until_steady`): then send a
-    /// checkpoint after the last impact with `complete`, so the job can resume from it.
+    /// Whether the job's cell may later ask for more impacts (`until_steady`, whose cap a
+    /// later spec may raise): then send a checkpoint after the last impact with `complete`, so
+    /// the job can resume from it.
     #[serde(default)]
     pub extendable: bool,
     /// The latest checkpoint, if any.

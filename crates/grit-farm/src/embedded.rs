@@ -93,12 +93,14 @@ pub enum EmbeddedError {
         source: crate::Error,
     },
     /// The output folder holds another spec's campaign.
-    #[error("--out {out} holds the results of another campaign ({id}); give a fresh --out for this spec, or run that campaign's own spec there to resume it")]
+    #[error("--out {out} holds the results of another campaign ({id}; {why}); give a fresh --out for this spec, or run that campaign's own spec there to resume it (a spec differing only in higher until_steady.max values raises its caps)")]
     OtherCampaign {
         /// The folder.
         out: PathBuf,
         /// The campaign already in its database.
         id: uuid::Uuid,
+        /// What makes this spec another campaign.
+        why: String,
     },
     /// The output folder's campaign is pinned to another engine than this grit's.
     #[error("--out {out} holds this campaign pinned to engine {pinned}, and this grit computes {own}: its samples would mix two engines' bits. Resume it with a grit of engine {pinned}, or pass --engine-upgrade NEW_DIR to run the spec afresh there with this engine")]
@@ -198,6 +200,21 @@ pub async fn engine_mismatch(
     mismatch(&store, c.id, spec).await
 }
 
+/// One line on a cell whose cap was raised, for the run's output.
+fn raised_line(r: &crate::db::CapRaised) -> String {
+    let head = format!(
+        "cell {}: until_steady.max raised from {} to {}",
+        r.cap.cell, r.cap.from, r.cap.to
+    );
+    match r.reopened_to {
+        Some(to) => format!(
+            "{head}; reopened for {to} impacts per sample, {} of {} samples from their state at {}",
+            r.resumed, r.samples, r.cap.from
+        ),
+        None => head,
+    }
+}
+
 /// Runs `spec` to the end (or until `stop`) and returns its results; `on_event` hears of the
 /// start, every status poll and anything worth a line.
 pub async fn run(
@@ -215,13 +232,31 @@ pub async fn run(
     store.requeue_all_leases().await?;
     let key = any_campaign_key(spec)?;
     // One campaign per folder: another spec's results.json and charts would overwrite this
-    // one's, and its charts would mix with them.
+    // one's, and its charts would mix with them. The same campaign with higher caps runs on.
     if !store.has_key(&key).await? {
         if let Some(other) = store.list_campaigns().await?.first() {
-            return Err(EmbeddedError::OtherCampaign {
-                out: opts.out.clone(),
-                id: other.id,
-            });
+            if let Some((pinned, own)) = mismatch(&store, other.id, spec).await? {
+                return Err(EmbeddedError::OtherEngine {
+                    out: opts.out.clone(),
+                    pinned,
+                    own,
+                });
+            }
+            match store.raise_caps(other.id, spec, &key).await {
+                Ok(raised) => {
+                    for r in raised {
+                        on_event(RunEvent::Note(raised_line(&r)));
+                    }
+                }
+                Err(crate::Error::Conflict(why)) => {
+                    return Err(EmbeddedError::OtherCampaign {
+                        out: opts.out.clone(),
+                        id: other.id,
+                        why,
+                    })
+                }
+                Err(e) => return Err(e.into()),
+            }
         }
     }
     let created = store.create(spec, Some(&key)).await?;

@@ -177,6 +177,90 @@ impl AnySpec {
     }
 }
 
+/// A cell whose `until_steady.max` a later spec of the same campaign raises
+/// (`docs/erosion.md`, "Raising the cap").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RaisedCap {
+    /// The cell's index.
+    pub cell: u32,
+    /// Its cap so far (impacts per sample).
+    pub from: u32,
+    /// Its new cap.
+    pub to: u32,
+}
+
+impl PlannedCell {
+    /// `cell 3 (60°, hexagon)`, or `cell 3` for a scene without angles.
+    fn label(&self) -> String {
+        match (self.angle_deg, &self.shape) {
+            (Some(a), Some(s)) => format!("cell {} ({a}°, {s})", self.index),
+            _ => format!("cell {}", self.index),
+        }
+    }
+}
+
+impl CampaignPlan {
+    /// The cells whose `until_steady.max` `new` raises, when `new` plans this same campaign
+    /// (scene, samples, seeds, cells, parameters and every other rule) but for higher caps:
+    /// a stored campaign whose cells stopped at their cap unsteady may so run on. `Err` names
+    /// the first thing that differs, or says that nothing is raised.
+    pub fn raised_caps(&self, new: &CampaignPlan) -> Result<Vec<RaisedCap>, String> {
+        let same = |what: &str, equal: bool| {
+            if equal {
+                Ok(())
+            } else {
+                Err(format!("its {what} differ"))
+            }
+        };
+        same("scenes", self.kind == new.kind)?;
+        same("samples", self.samples == new.samples)?;
+        same(
+            "sample rules (samples.target_sem_rel, max)",
+            self.target_sem == new.target_sem,
+        )?;
+        same("queue orders", self.queue == new.queue)?;
+        same("cell counts", self.cells.len() == new.cells.len())?;
+        same("jobs or seeds", self.jobs == new.jobs)?;
+        let mut raised = Vec::new();
+        for (old, cell) in self.cells.iter().zip(&new.cells) {
+            let (Some(was), Some(now)) = (old.until_steady, cell.until_steady) else {
+                same(&format!("{}'s plans", old.label()), old == cell)?;
+                continue;
+            };
+            let mut kept = cell.clone();
+            kept.until_steady = Some(UntilSteady {
+                max: was.max,
+                ..now
+            });
+            if *old != kept {
+                return Err(format!(
+                    "{} differs in more than until_steady.max",
+                    old.label()
+                ));
+            }
+            if now.max < was.max {
+                return Err(format!(
+                    "{}: until_steady.max may only be raised, from {} (got {})",
+                    old.label(),
+                    was.max,
+                    now.max
+                ));
+            }
+            if now.max > was.max {
+                raised.push(RaisedCap {
+                    cell: old.index,
+                    from: was.max,
+                    to: now.max,
+                });
+            }
+        }
+        if raised.is_empty() {
+            return Err("it raises no cell's until_steady.max".into());
+        }
+        Ok(raised)
+    }
+}
+
 /// A scene's parameters as the JSON a farm stores, with round-trip floats.
 fn json<T: Serialize>(params: &T) -> String {
     serde_json::to_string(params).expect("scene parameters are plain data")
@@ -236,5 +320,55 @@ mod tests {
         assert_eq!(e.field, "angles_deg");
         let e = AnySpec::from_json(r#"{"time_ms": 1}"#).unwrap_err();
         assert_eq!(e.field, "time_ms");
+    }
+
+    fn planned(impacts: &str, extra: &str) -> CampaignPlan {
+        AnySpec::from_json(&format!(
+            r#"{{"seed": 4, "angles_deg": [15, 90], "shapes": ["hexagon"], "samples": 3, "impacts": {impacts}{extra}}}"#
+        ))
+        .unwrap()
+        .plan()
+        .unwrap()
+    }
+
+    #[test]
+    fn a_later_spec_may_raise_the_caps_and_nothing_else() {
+        let rule =
+            |max: u32| format!(r#"{{"until_steady": {{"min": 40, "max": {max}, "step": 20}}}}"#);
+        let old = planned(&rule(400), "");
+        let raised = old.raised_caps(&planned(&rule(800), "")).unwrap();
+        assert_eq!(
+            raised,
+            [0, 1].map(|cell| RaisedCap {
+                cell,
+                from: 400,
+                to: 800
+            })
+        );
+        // Per angle: only the 90° cell is raised.
+        let per_angle = format!(r#"{{"90": {}, "default": {}}}"#, rule(600), rule(400));
+        assert_eq!(
+            old.raised_caps(&planned(&per_angle, "")).unwrap(),
+            [RaisedCap {
+                cell: 1,
+                from: 400,
+                to: 600
+            }]
+        );
+        let refused = |new: CampaignPlan| old.raised_caps(&new).unwrap_err();
+        assert_eq!(
+            refused(planned(&rule(400), "")),
+            "it raises no cell's until_steady.max"
+        );
+        assert!(refused(planned(&rule(300), "")).contains("may only be raised, from 400 (got 300)"));
+        assert!(refused(planned(&rule(800), r#", "velocity_m_s": 80"#))
+            .contains("more than until_steady.max"));
+        assert!(
+            refused(planned(&rule(800), r#", "seed": 5"#)).contains("seeds"),
+            "a new seed: other samples"
+        );
+        let step = r#"{"until_steady": {"min": 40, "max": 800, "step": 10}}"#;
+        assert!(refused(planned(step, "")).contains("cell 0 (15°, hexagon) differs"));
+        assert!(refused(planned("40", "")).contains("cell 0 (15°, hexagon)'s plans"));
     }
 }

@@ -28,7 +28,7 @@ mod plan;
 mod stored;
 pub use crate::scenes::impact::spec::{CampaignSpec, Cell, GrainSpec, Impacts, QueueOrder};
 pub use crate::scenes::jet::spec::{JetCampaignSpec, JetCell, Scene};
-pub use any::{AnySpec, CampaignPlan, PlannedCell};
+pub use any::{AnySpec, CampaignPlan, PlannedCell, RaisedCap};
 pub use plan::{
     annotate, next_step, sem_rel, ImpactPlan, NextStep, Samples, TargetSem, UntilSteady,
 };

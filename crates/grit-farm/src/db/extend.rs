@@ -7,13 +7,14 @@
 use std::collections::BTreeMap;
 
 use grit_erosion::campaign::{
-    job_seed, NextStep, QueueOrder, StoredCell, TargetSem, UnitMasses, UntilSteady,
+    job_seed, AnySpec, NextStep, QueueOrder, RaisedCap, StoredCell, TargetSem, UnitMasses,
+    UntilSteady,
 };
 use serde::Deserialize;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
-use super::{insert_queued_jobs, NewJob, Store};
+use super::{insert_queued_jobs, now_ms, NewJob, Store};
 use crate::error::{Error, Result};
 use crate::scenes::FarmScene;
 
@@ -79,6 +80,101 @@ impl Store {
     }
 }
 
+/// A cell whose cap [`Store::raise_caps`] raised.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CapRaised {
+    /// The cell and its caps.
+    pub cap: RaisedCap,
+    /// Impacts per sample the cell was planned for anew, when it had stopped at its old cap
+    /// unsteady; `None` for a cell still running or that had met its rule.
+    pub reopened_to: Option<u32>,
+    /// Of its samples, how many run on from their state at the old cap; the others run their
+    /// impacts again from their last checkpoint or the start (the same bits, at their cost).
+    pub resumed: u32,
+    /// Its samples.
+    pub samples: u32,
+}
+
+impl Store {
+    /// Raises the caps (`until_steady.max`) of campaign `id` to those of `spec`, a spec of the
+    /// same campaign but for its caps ([`grit_erosion::campaign::CampaignPlan::raised_caps`]),
+    /// stores `spec` under `key` in place of the old one, and plans anew every cell that had
+    /// stopped at its old cap short of its rule, in one transaction. A `Conflict` names what
+    /// makes `spec` another campaign.
+    pub async fn raise_caps(&self, id: Uuid, spec: &AnySpec, key: &str) -> Result<Vec<CapRaised>> {
+        let campaign = id.to_string();
+        let mut tx = self.begin().await?;
+        let row = sqlx::query("SELECT spec, cancelled_ms, scene FROM campaigns WHERE id = ?")
+            .bind(&campaign)
+            .fetch_optional(&mut *tx)
+            .await?
+            .ok_or_else(|| Error::NotFound(format!("campaign {id}")))?;
+        if row.get::<Option<i64>, _>(1).is_some() {
+            return Err(Error::Conflict("campaign is cancelled".into()));
+        }
+        let other = |why: String| Error::Conflict(format!("not the stored campaign: {why}"));
+        let stored = AnySpec::from_json(row.get::<&str, _>(0))
+            .map_err(|e| other(format!("its stored spec no longer reads ({e})")))?;
+        if stored.name() != spec.name() || stored.engine() != spec.engine() {
+            return Err(other("its names or pinned engines differ".into()));
+        }
+        let raised = stored.plan()?.raised_caps(&spec.plan()?).map_err(other)?;
+        let scene = self.scenes.get(row.get::<&str, _>(2))?;
+        let now = now_ms();
+        let mut report = Vec::new();
+        for cap in raised {
+            let cell = cap.cell as i64;
+            let r = sqlx::query(&format!(
+                "UPDATE cells SET units_max = ? WHERE campaign_id = ? AND cell_index = ?
+                 RETURNING {CELL_COLUMNS}"
+            ))
+            .bind(cap.to as i64)
+            .bind(&campaign)
+            .bind(cell)
+            .fetch_one(&mut *tx)
+            .await?;
+            let plan = stored_cell(&r)?;
+            let resumed: i64 = sqlx::query(
+                "SELECT COUNT(*) FROM jobs j JOIN checkpoints k ON k.job_id = j.id
+                 WHERE j.campaign_id = ? AND j.cell_index = ? AND k.units_done = ?",
+            )
+            .bind(&campaign)
+            .bind(cell)
+            .bind(plan.units as i64)
+            .fetch_one(&mut *tx)
+            .await?
+            .get(0);
+            // A cell whose last round still runs is judged under the new cap when it ends;
+            // one that met its rule below the old cap stays as it is.
+            let at_rest = plan.units >= cap.from
+                && settle_cell(&mut tx, &*scene, &campaign, &plan, now).await?;
+            let units: i64 =
+                sqlx::query("SELECT units FROM cells WHERE campaign_id = ? AND cell_index = ?")
+                    .bind(&campaign)
+                    .bind(cell)
+                    .fetch_one(&mut *tx)
+                    .await?
+                    .get(0);
+            report.push(CapRaised {
+                cap,
+                reopened_to: (at_rest && units as u32 > plan.units).then_some(units as u32),
+                resumed: resumed as u32,
+                samples: plan.samples,
+            });
+        }
+        let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
+        sqlx::query("UPDATE campaigns SET spec = ?, idempotency_key = ? WHERE id = ?")
+            .bind(spec_json)
+            .bind(key)
+            .bind(&campaign)
+            .execute(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        tracing::info!(campaign = %id, ?report, "caps raised");
+        Ok(report)
+    }
+}
+
 /// What a farm reads of any stored spec: the campaign's seed, which every job's derives from,
 /// and the order its jobs are handed out in.
 #[derive(Deserialize)]
@@ -89,15 +185,16 @@ struct Seeded {
 }
 
 /// After a job of cell `plan`, one with growth rules, completed: once every job of the cell
-/// is done, grows the cell as its scene decides or finishes it. Runs inside the completing
-/// transaction, so a crash anywhere leaves either the job still leased or the cell fully grown.
+/// is done, grows the cell as its scene decides or finishes it, and says so (`false`: jobs of
+/// the cell are still open). Runs inside the completing transaction, so a crash anywhere
+/// leaves either the job still leased or the cell fully grown.
 pub(super) async fn settle_cell(
     tx: &mut Transaction<'static, Sqlite>,
     scene: &dyn FarmScene,
     campaign: &str,
     plan: &StoredCell,
     now: i64,
-) -> Result<()> {
+) -> Result<bool> {
     let cell = plan.index as i64;
     let open: i64 = sqlx::query(
         "SELECT COUNT(*) FROM jobs WHERE campaign_id = ? AND cell_index = ? AND state != 'done'",
@@ -108,7 +205,7 @@ pub(super) async fn settle_cell(
     .await?
     .get(0);
     if open > 0 {
-        return Ok(());
+        return Ok(false);
     }
     // A unit stored before its masses had columns is read from its record.
     let rows = sqlx::query(
@@ -188,8 +285,10 @@ pub(super) async fn settle_cell(
     let drop_checkpoints = match step {
         NextStep::ExtendImpacts(_) => false,
         // Added samples may leave the cell unsteady again, and then every sample grows.
-        NextStep::AddSamples(_) => !plan.units_may_grow(),
-        NextStep::Final => true,
+        NextStep::AddSamples(_) => plan.until_steady.is_none(),
+        // A cell stopped at its cap unsteady keeps its samples' last states, so that a later
+        // spec raising the cap runs them on (`Store::raise_caps`).
+        NextStep::Final => !stopped_at_cap(scene, plan, &samples)?,
     };
     if drop_checkpoints {
         sqlx::query(
@@ -202,7 +301,30 @@ pub(super) async fn settle_cell(
         .await?;
     }
     tracing::info!(campaign, cell, ?step, "cell assessed");
-    Ok(())
+    Ok(true)
+}
+
+/// Whether cell `plan`, assessed final, stopped at its cap short of its rule: under a higher
+/// cap its scene would grow it.
+fn stopped_at_cap(
+    scene: &dyn FarmScene,
+    plan: &StoredCell,
+    samples: &BTreeMap<u32, Vec<UnitMasses>>,
+) -> Result<bool> {
+    let Some(u) = plan.until_steady.filter(|u| plan.units >= u.max) else {
+        return Ok(false);
+    };
+    let uncapped = StoredCell {
+        until_steady: Some(UntilSteady {
+            max: plan.units.saturating_add(u.step),
+            ..u
+        }),
+        ..plan.clone()
+    };
+    Ok(matches!(
+        scene.next_step(&uncapped, samples)?,
+        NextStep::ExtendImpacts(_)
+    ))
 }
 
 /// The cell's new plan: impacts per sample, or samples.

@@ -4,12 +4,12 @@
 use std::path::Path;
 use std::time::Duration;
 
-use grit_erosion::campaign::{job_seed, CampaignSpec};
+use grit_erosion::campaign::{job_seed, AnySpec, CampaignSpec, RaisedCap};
 use grit_erosion::ImpactRecord;
 use sqlx::Row;
 use uuid::Uuid;
 
-use super::{imp, impact_params, impact_results, Store};
+use super::{imp, impact_params, impact_results, CapRaised, Store};
 use crate::api::{CampaignState, ClaimedJob};
 use crate::checkpoint::CheckpointBytes;
 use crate::loadtest::placeholder_record;
@@ -123,15 +123,19 @@ async fn an_unsteady_cell_grows_by_step_and_stops_at_max_flagged() {
     assert!(b.extendable);
     assert_eq!(b.checkpoint.as_ref().map(|c| c.impacts_done), Some(21));
     run_one(&s, |_, _| 0.0).await;
-    // 24 + 3 is capped at 25; the jobs then run without needing a checkpoint afterwards.
+    // 24 + 3 is capped at 25; the state after it is still asked for, should the cap be raised.
     let c = run_one(&s, |_, _| 0.0).await;
-    assert_eq!((c.impacts_planned, c.extendable), (25, false));
+    assert_eq!((c.impacts_planned, c.extendable), (25, true));
     run_one(&s, |_, _| 0.0).await;
     let st = s.status(id).await.unwrap();
     assert_eq!(st.state, CampaignState::Done);
     assert_eq!((st.impacts_total, st.impacts_done), (50, 50));
     assert!(s.claim("w").await.unwrap().is_none());
-    assert_eq!(checkpoints(&s).await, 0, "dropped once the cell is final");
+    assert_eq!(
+        checkpoints(&s).await,
+        2,
+        "kept: the cell stopped at its cap unsteady"
+    );
     let r = impact_results(&s, id).await;
     let cell = &r.cells[0];
     assert_eq!(cell.impacts_planned, 25);
@@ -381,6 +385,118 @@ async fn each_units_damage_added_is_stored_beside_its_masses_and_balances_the_ce
 /// its last completion (which judges it) against the others, and the read of its units'
 /// masses from their columns against parsing every record. Run by hand, on an idle machine:
 /// `cargo test --release -p grit-farm --lib settle_cost -- --ignored --nocapture`.
+/// [`spec`]'s never-steady cell of 2 samples capped at `max`, for [`Store::raise_caps`].
+fn capped(max: u32) -> AnySpec {
+    AnySpec::Impact(spec(
+        &format!(r#"{{"until_steady": {{"min": 21, "max": {max}, "step": 3}}}}"#),
+        "2",
+    ))
+}
+
+#[tokio::test]
+async fn a_raised_cap_runs_a_cell_stopped_there_on_from_its_last_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let id = s.create(&capped(24), Some("a")).await.unwrap().id;
+    for _ in 0..4 {
+        run_one(&s, |_, _| 0.0).await;
+    }
+    assert_eq!(s.status(id).await.unwrap().state, CampaignState::Done);
+    assert_eq!(checkpoints(&s).await, 2);
+    let raised = s.raise_caps(id, &capped(30), "b").await.unwrap();
+    assert_eq!(
+        raised,
+        [CapRaised {
+            cap: RaisedCap {
+                cell: 0,
+                from: 24,
+                to: 30
+            },
+            reopened_to: Some(27),
+            resumed: 2,
+            samples: 2,
+        }]
+    );
+    let st = s.status(id).await.unwrap();
+    assert_eq!(st.state, CampaignState::Running);
+    assert_eq!((st.jobs.queued, st.impacts_total), (2, 54));
+    // The new spec now resumes the campaign; the old one is another campaign.
+    assert!(s.has_key("b").await.unwrap() && !s.has_key("a").await.unwrap());
+    let j = run_one(&s, |_, _| 0.0).await;
+    assert_eq!((j.impacts_done, j.impacts_planned), (24, 27));
+    assert_eq!(j.checkpoint.as_ref().map(|c| c.impacts_done), Some(24));
+    for _ in 0..3 {
+        run_one(&s, |_, _| 0.0).await;
+    }
+    assert!(s.claim("w").await.unwrap().is_none());
+    let r = impact_results(&s, id).await;
+    assert_eq!(r.cells[0].impacts_planned, 30);
+    let ss = r.cells[0].steady_state.as_ref().unwrap();
+    assert!(
+        ss.reason.starts_with("reached max 30 impacts; "),
+        "{}",
+        ss.reason
+    );
+    assert_eq!(
+        checkpoints(&s).await,
+        2,
+        "unsteady at the new cap: kept again"
+    );
+}
+
+#[tokio::test]
+async fn a_cell_steady_at_its_cap_keeps_no_state_and_stays_final_when_raised() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let rule = |max: u32| {
+        AnySpec::Impact(spec(
+            &format!(r#"{{"until_steady": {{"min": 60, "max": {max}, "step": 5}}}}"#),
+            "2",
+        ))
+    };
+    let id = s.create(&rule(60), None).await.unwrap().id;
+    run_one(&s, |_, _| 0.3).await;
+    run_one(&s, |_, _| 0.3).await;
+    assert_eq!(
+        checkpoints(&s).await,
+        0,
+        "steady at the cap: nothing to run on"
+    );
+    let raised = s.raise_caps(id, &rule(80), "k").await.unwrap();
+    assert_eq!((raised[0].reopened_to, raised[0].resumed), (None, 0));
+    let st = s.status(id).await.unwrap();
+    assert_eq!((st.state, st.impacts_total), (CampaignState::Done, 120));
+}
+
+#[tokio::test]
+async fn only_higher_caps_of_the_same_campaign_are_raised() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path()).await;
+    let id = s.create(&capped(24), Some("a")).await.unwrap().id;
+    let refused = |e: crate::Error| match e {
+        crate::Error::Conflict(why) => why,
+        other => panic!("{other}"),
+    };
+    let why = refused(s.raise_caps(id, &capped(24), "b").await.unwrap_err());
+    assert!(why.contains("raises no cell's until_steady.max"), "{why}");
+    let why = refused(s.raise_caps(id, &capped(22), "b").await.unwrap_err());
+    assert!(
+        why.contains("may only be raised, from 24 (got 22)"),
+        "{why}"
+    );
+    let renamed = AnySpec::from_json(
+        r#"{"name": "x", "seed": 5, "angles_deg": [90], "shapes": ["hexagon"], "spacing_m": 25e-6,
+            "impacts": {"until_steady": {"min": 21, "max": 30, "step": 3}}, "samples": 2}"#,
+    )
+    .unwrap();
+    let why = refused(s.raise_caps(id, &renamed, "b").await.unwrap_err());
+    assert!(why.contains("names or pinned engines differ"), "{why}");
+    s.cancel(id).await.unwrap();
+    let why = refused(s.raise_caps(id, &capped(30), "b").await.unwrap_err());
+    assert!(why.contains("cancelled"), "{why}");
+    assert!(s.has_key("a").await.unwrap(), "nothing changed");
+}
+
 #[tokio::test]
 #[ignore]
 async fn settle_cost() {

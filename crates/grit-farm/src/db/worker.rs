@@ -430,9 +430,9 @@ pub(super) async fn apply_claim(
     .bind(cell)
     .fetch_one(&mut **tx)
     .await?;
-    let extendable = c
-        .get::<Option<i64>, _>(2)
-        .is_some_and(|max| c.get::<i64, _>(1) < max);
+    // At its cap too: a cell stopped there unsteady runs on from these states once a later
+    // spec raises the cap (`Store::raise_caps`).
+    let extendable = c.get::<Option<i64>, _>(2).is_some();
     let checkpoint = c
         .get::<Option<i64>, _>(3)
         .map(|impacts_done| StoredCheckpoint {
@@ -503,8 +503,9 @@ pub(super) async fn apply_complete(
         ));
     }
     end_lease(tx, job_id, "done", done, now).await?;
-    // A job that never stored a checkpoint has none to drop.
-    if !held.cell.units_may_grow() && (held.has_checkpoint || checkpoint.is_some()) {
+    // A job that never stored a checkpoint has none to drop; a growing cell's are dropped
+    // once it is assessed final.
+    if held.cell.until_steady.is_none() && (held.has_checkpoint || checkpoint.is_some()) {
         sqlx::query("DELETE FROM checkpoints WHERE job_id = ?")
             .bind(job_id)
             .execute(&mut **tx)
@@ -514,7 +515,8 @@ pub(super) async fn apply_complete(
         return Ok(());
     }
     let scene = scenes.get(&held.scene)?;
-    super::extend::settle_cell(tx, &*scene, &held.campaign, &held.cell, now).await
+    super::extend::settle_cell(tx, &*scene, &held.campaign, &held.cell, now).await?;
+    Ok(())
 }
 
 /// A failure in `tx`, by the rules of [`Store::fail`]; `error` comes cut to
