@@ -234,7 +234,7 @@ impl CampaignResults {
         self.cells
             .iter()
             .filter_map(|c| {
-                let b = c.damage_balance.filter(|b| !b.balanced)?;
+                let b = c.damage_balance.filter(|b| !b.holds())?;
                 let what = if b.loss_rate < b.damage_rate {
                     "still stores damage; its stationary rate lies between the two"
                 } else {

@@ -67,6 +67,17 @@ pub struct DamageBalance {
 }
 
 impl DamageBalance {
+    /// The balance rule on these numbers: |loss − damage added| within [`BALANCE_SIGMAS`]
+    /// standard errors of the difference and loss ≥ [`BALANCE_MIN_RATIO`] × damage added. A
+    /// results file written under an earlier rule is judged by this one when read.
+    pub fn holds(&self) -> bool {
+        let rounding = 1e-9 * self.loss_rate.abs().max(self.damage_rate.abs());
+        let within = (self.loss_rate - self.damage_rate).abs()
+            <= BALANCE_SIGMAS * self.difference_sem + rounding;
+        let ratio = (self.damage_rate > 0.0).then(|| self.loss_rate / self.damage_rate);
+        within && ratio.is_none_or(|r| r >= BALANCE_MIN_RATIO)
+    }
+
     /// The comparison in words, rates in mg/g.
     pub fn describe(&self) -> String {
         let z = if self.difference_sem > 0.0 {
@@ -109,11 +120,8 @@ pub fn assess(samples: &[&SampleInput]) -> Option<DamageBalance> {
     let difference: Vec<f64> = loss.iter().zip(&damage).map(|(l, d)| l - d).collect();
     let (l, d, diff) = (stats(&loss)?, stats(&damage)?, stats(&difference)?);
     let difference_sem = diff.sem?;
-    let rounding = 1e-9 * l.mean.abs().max(d.mean.abs());
     let positive = |x: f64| (d.mean > 0.0).then_some(x / d.mean);
-    let ratio = positive(l.mean);
-    let within = diff.mean.abs() <= BALANCE_SIGMAS * difference_sem + rounding;
-    Some(DamageBalance {
+    let mut b = DamageBalance {
         points: BALANCE_POINTS,
         samples: loss.len(),
         loss_rate: l.mean,
@@ -121,10 +129,12 @@ pub fn assess(samples: &[&SampleInput]) -> Option<DamageBalance> {
         damage_rate: d.mean,
         damage_rate_sem: d.sem?,
         difference_sem,
-        ratio,
-        balanced: within && ratio.is_none_or(|r| r >= BALANCE_MIN_RATIO),
+        ratio: positive(l.mean),
+        balanced: false,
         detectable_rel: positive(BALANCE_SIGMAS * difference_sem),
-    })
+    };
+    b.balanced = b.holds();
+    Some(b)
 }
 
 #[cfg(test)]
