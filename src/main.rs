@@ -96,6 +96,12 @@ enum Command {
     /// Cancel a campaign: no more jobs are handed out; running workers drop theirs.
     #[command(after_help = "Example: grit cancel 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40")]
     Cancel(campaign::IdArgs),
+    /// Raise a campaign's until_steady caps: the cells stopped at the old cap short of their
+    /// rule run on from their samples' states there (`grit run` does so with the raised spec).
+    #[command(
+        after_help = "Example: grit raise-caps 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40 paper-800.json"
+    )]
+    RaiseCaps(campaign::RaiseCapsArgs),
     /// Put a campaign's failed jobs back in the queue.
     #[command(after_help = "Example: grit retry-failed 0b6f4a52-3c1e-4d2a-9f8e-2a7c5d1e9b40")]
     RetryFailed(campaign::IdArgs),
@@ -133,6 +139,7 @@ fn main() -> ExitCode {
         Command::Status(a) => farm("warn", campaign::status(a)),
         Command::Results(a) => farm("warn", campaign::results(a)),
         Command::Cancel(a) => farm("warn", campaign::cancel(a)),
+        Command::RaiseCaps(a) => farm("warn", campaign::raise_caps(a)),
         Command::RetryFailed(a) => farm("warn", campaign::retry_failed(a)),
     };
     match result {

@@ -793,4 +793,33 @@ async fn until_steady_extends_samples_bit_for_bit() {
         cell["steady_state"]
     );
     assert_bitwise_equal(&raw_series(&farm_results), &local);
+
+    // Served too, `grit raise-caps` runs the cell on from its samples' states at 25; a lower
+    // cap is refused (409) naming the rule.
+    let file = dir.path().join("raised-27.json");
+    std::fs::write(&file, spec.replace(r#""max": 25"#, r#""max": 27"#)).unwrap();
+    let out = grit_cli(
+        &coord.url,
+        &["raise-caps", &id.to_string(), file.to_str().unwrap()],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("cell 0: until_steady.max raised from 25 to 27; reopened for 27 impacts per sample, 2 of 2 samples from their state at 25"),
+        "{said}"
+    );
+    let s = wait_done(&c, id, Duration::from_secs(120)).await;
+    assert_eq!((s.impacts_done, s.impacts_total), (54, 54));
+    let on = raw_series(&c.results_value(id, true).await.unwrap());
+    let head: Vec<_> = on
+        .iter()
+        .map(|(c, s, r)| (*c, *s, r[..25].to_vec()))
+        .collect();
+    assert_bitwise_equal(&head, &local);
+    let e = c.raise_caps(id, &spec).await.unwrap_err().to_string();
+    assert!(e.contains("may only be raised, from 27 (got 25)"), "{e}");
 }

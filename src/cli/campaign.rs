@@ -96,6 +96,17 @@ pub struct SubmitArgs {
     remote: Remote,
 }
 
+/// `grit raise-caps`.
+#[derive(Args, Debug)]
+pub struct RaiseCapsArgs {
+    /// Campaign id.
+    pub id: String,
+    /// The campaign's spec with higher `until_steady.max` values; `-` reads standard input.
+    pub file: PathBuf,
+    #[command(flatten)]
+    remote: Remote,
+}
+
 /// `grit status`.
 #[derive(Args, Debug)]
 pub struct StatusArgs {
@@ -573,6 +584,27 @@ pub async fn cancel(a: IdArgs) -> anyhow::Result<ExitCode> {
     let id = parse_id(&a.id)?;
     let r = a.remote.client()?.cancel(id).await?;
     say!("cancelled {id}: {} jobs stopped", r.jobs);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `grit raise-caps`.
+pub async fn raise_caps(a: RaiseCapsArgs) -> anyhow::Result<ExitCode> {
+    let id = parse_id(&a.id)?;
+    let text = read_spec_text(&a.file)?;
+    let r = a
+        .remote
+        .client()?
+        .raise_caps(id, &text)
+        .await
+        .map_err(|e| match e {
+            ClientError::Status { message, .. } => {
+                anyhow::anyhow!("{}: {message}", a.file.display())
+            }
+            other => other.into(),
+        })?;
+    for cell in &r.raised {
+        say!("{}", cell.describe());
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -333,6 +333,50 @@ pub struct JobsChanged {
     pub jobs: u64,
 }
 
+/// A cell whose `until_steady.max` `POST /campaigns/{id}/raise-caps` (or `grit run` with the
+/// raised spec) raised (`docs/erosion.md`, "Raising the cap").
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+pub struct RaisedCell {
+    /// The cell's index.
+    pub cell: u32,
+    /// Its cap so far (impacts per sample).
+    pub from: u32,
+    /// Its new cap.
+    pub to: u32,
+    /// Impacts per sample the cell was planned for anew, when it had stopped at its old cap
+    /// short of its rule; `null` for a cell still running or one that had met its rule.
+    pub reopened_to: Option<u32>,
+    /// Of its samples, how many run on from their state at the old cap; the others run their
+    /// impacts again from their last checkpoint or the start (the same bits, at their cost).
+    pub resumed: u32,
+    /// Its samples.
+    pub samples: u32,
+}
+
+impl RaisedCell {
+    /// One line for a person.
+    pub fn describe(&self) -> String {
+        let head = format!(
+            "cell {}: until_steady.max raised from {} to {}",
+            self.cell, self.from, self.to
+        );
+        match self.reopened_to {
+            Some(to) => format!(
+                "{head}; reopened for {to} impacts per sample, {} of {} samples from their state at {}",
+                self.resumed, self.samples, self.from
+            ),
+            None => head,
+        }
+    }
+}
+
+/// Answer to `POST /campaigns/{id}/raise-caps`.
+#[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
+pub struct CapsRaised {
+    /// Every cell whose cap was raised, in cell order.
+    pub raised: Vec<RaisedCell>,
+}
+
 /// `POST /worker/claim` body.
 #[derive(Debug, Clone, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]

@@ -219,6 +219,16 @@ impl Client {
             .await
     }
 
+    /// Raises a campaign's `until_steady` caps to those of `spec`, its spec with higher caps.
+    pub async fn raise_caps(&self, id: Uuid, spec: &str) -> Result<CapsRaised, ClientError> {
+        let rb = self
+            .http
+            .post(self.url(&format!("/campaigns/{id}/raise-caps")))
+            .header(reqwest::header::CONTENT_TYPE, "application/json")
+            .body(spec.to_string());
+        Self::json(self.send(rb).await?).await
+    }
+
     /// Requeues a campaign's failed jobs.
     pub async fn retry_failed(&self, id: Uuid) -> Result<JobsChanged, ClientError> {
         self.post(

@@ -200,21 +200,6 @@ pub async fn engine_mismatch(
     mismatch(&store, c.id, spec).await
 }
 
-/// One line on a cell whose cap was raised, for the run's output.
-fn raised_line(r: &crate::db::CapRaised) -> String {
-    let head = format!(
-        "cell {}: until_steady.max raised from {} to {}",
-        r.cap.cell, r.cap.from, r.cap.to
-    );
-    match r.reopened_to {
-        Some(to) => format!(
-            "{head}; reopened for {to} impacts per sample, {} of {} samples from their state at {}",
-            r.resumed, r.samples, r.cap.from
-        ),
-        None => head,
-    }
-}
-
 /// Runs `spec` to the end (or until `stop`) and returns its results; `on_event` hears of the
 /// start, every status poll and anything worth a line.
 pub async fn run(
@@ -242,10 +227,10 @@ pub async fn run(
                     own,
                 });
             }
-            match store.raise_caps(other.id, spec, &key).await {
+            match store.raise_caps(other.id, spec, Some(&key)).await {
                 Ok(raised) => {
                     for r in raised {
-                        on_event(RunEvent::Note(raised_line(&r)));
+                        on_event(RunEvent::Note(r.describe()));
                     }
                 }
                 Err(crate::Error::Conflict(why)) => {

@@ -7,14 +7,14 @@
 use std::collections::BTreeMap;
 
 use grit_erosion::campaign::{
-    job_seed, AnySpec, NextStep, QueueOrder, RaisedCap, StoredCell, TargetSem, UnitMasses,
-    UntilSteady,
+    job_seed, AnySpec, NextStep, QueueOrder, StoredCell, TargetSem, UnitMasses, UntilSteady,
 };
 use serde::Deserialize;
 use sqlx::{Row, Sqlite, Transaction};
 use uuid::Uuid;
 
 use super::{insert_queued_jobs, now_ms, NewJob, Store};
+use crate::api::RaisedCell;
 use crate::error::{Error, Result};
 use crate::scenes::FarmScene;
 
@@ -80,28 +80,18 @@ impl Store {
     }
 }
 
-/// A cell whose cap [`Store::raise_caps`] raised.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct CapRaised {
-    /// The cell and its caps.
-    pub cap: RaisedCap,
-    /// Impacts per sample the cell was planned for anew, when it had stopped at its old cap
-    /// unsteady; `None` for a cell still running or that had met its rule.
-    pub reopened_to: Option<u32>,
-    /// Of its samples, how many run on from their state at the old cap; the others run their
-    /// impacts again from their last checkpoint or the start (the same bits, at their cost).
-    pub resumed: u32,
-    /// Its samples.
-    pub samples: u32,
-}
-
 impl Store {
     /// Raises the caps (`until_steady.max`) of campaign `id` to those of `spec`, a spec of the
     /// same campaign but for its caps ([`grit_erosion::campaign::CampaignPlan::raised_caps`]),
-    /// stores `spec` under `key` in place of the old one, and plans anew every cell that had
-    /// stopped at its old cap short of its rule, in one transaction. A `Conflict` names what
-    /// makes `spec` another campaign.
-    pub async fn raise_caps(&self, id: Uuid, spec: &AnySpec, key: &str) -> Result<Vec<CapRaised>> {
+    /// stores `spec` in place of the old one (under `key` when given), and plans anew every
+    /// cell that had stopped at its old cap short of its rule, in one transaction. A
+    /// `Conflict` names what makes `spec` another campaign.
+    pub async fn raise_caps(
+        &self,
+        id: Uuid,
+        spec: &AnySpec,
+        key: Option<&str>,
+    ) -> Result<Vec<RaisedCell>> {
         let campaign = id.to_string();
         let mut tx = self.begin().await?;
         let row = sqlx::query("SELECT spec, cancelled_ms, scene FROM campaigns WHERE id = ?")
@@ -155,20 +145,25 @@ impl Store {
                     .fetch_one(&mut *tx)
                     .await?
                     .get(0);
-            report.push(CapRaised {
-                cap,
+            report.push(RaisedCell {
+                cell: cap.cell,
+                from: cap.from,
+                to: cap.to,
                 reopened_to: (at_rest && units as u32 > plan.units).then_some(units as u32),
                 resumed: resumed as u32,
                 samples: plan.samples,
             });
         }
         let spec_json = serde_json::to_string(spec).map_err(|e| Error::Internal(e.to_string()))?;
-        sqlx::query("UPDATE campaigns SET spec = ?, idempotency_key = ? WHERE id = ?")
-            .bind(spec_json)
-            .bind(key)
-            .bind(&campaign)
-            .execute(&mut *tx)
-            .await?;
+        sqlx::query(
+            "UPDATE campaigns SET spec = ?, idempotency_key = coalesce(?, idempotency_key)
+             WHERE id = ?",
+        )
+        .bind(spec_json)
+        .bind(key)
+        .bind(&campaign)
+        .execute(&mut *tx)
+        .await?;
         tx.commit().await?;
         tracing::info!(campaign = %id, ?report, "caps raised");
         Ok(report)

@@ -4,13 +4,13 @@
 use std::path::Path;
 use std::time::Duration;
 
-use grit_erosion::campaign::{job_seed, AnySpec, CampaignSpec, RaisedCap};
+use grit_erosion::campaign::{job_seed, AnySpec, CampaignSpec};
 use grit_erosion::ImpactRecord;
 use sqlx::Row;
 use uuid::Uuid;
 
-use super::{imp, impact_params, impact_results, CapRaised, Store};
-use crate::api::{CampaignState, ClaimedJob};
+use super::{imp, impact_params, impact_results, Store};
+use crate::api::{CampaignState, ClaimedJob, RaisedCell};
 use crate::checkpoint::CheckpointBytes;
 use crate::loadtest::placeholder_record;
 
@@ -403,15 +403,13 @@ async fn a_raised_cap_runs_a_cell_stopped_there_on_from_its_last_states() {
     }
     assert_eq!(s.status(id).await.unwrap().state, CampaignState::Done);
     assert_eq!(checkpoints(&s).await, 2);
-    let raised = s.raise_caps(id, &capped(30), "b").await.unwrap();
+    let raised = s.raise_caps(id, &capped(30), Some("b")).await.unwrap();
     assert_eq!(
         raised,
-        [CapRaised {
-            cap: RaisedCap {
-                cell: 0,
-                from: 24,
-                to: 30
-            },
+        [RaisedCell {
+            cell: 0,
+            from: 24,
+            to: 30,
             reopened_to: Some(27),
             resumed: 2,
             samples: 2,
@@ -462,7 +460,7 @@ async fn a_cell_steady_at_its_cap_keeps_no_state_and_stays_final_when_raised() {
         0,
         "steady at the cap: nothing to run on"
     );
-    let raised = s.raise_caps(id, &rule(80), "k").await.unwrap();
+    let raised = s.raise_caps(id, &rule(80), None).await.unwrap();
     assert_eq!((raised[0].reopened_to, raised[0].resumed), (None, 0));
     let st = s.status(id).await.unwrap();
     assert_eq!((st.state, st.impacts_total), (CampaignState::Done, 120));
@@ -477,9 +475,9 @@ async fn only_higher_caps_of_the_same_campaign_are_raised() {
         crate::Error::Conflict(why) => why,
         other => panic!("{other}"),
     };
-    let why = refused(s.raise_caps(id, &capped(24), "b").await.unwrap_err());
+    let why = refused(s.raise_caps(id, &capped(24), Some("b")).await.unwrap_err());
     assert!(why.contains("raises no cell's until_steady.max"), "{why}");
-    let why = refused(s.raise_caps(id, &capped(22), "b").await.unwrap_err());
+    let why = refused(s.raise_caps(id, &capped(22), Some("b")).await.unwrap_err());
     assert!(
         why.contains("may only be raised, from 24 (got 22)"),
         "{why}"
@@ -489,10 +487,10 @@ async fn only_higher_caps_of_the_same_campaign_are_raised() {
             "impacts": {"until_steady": {"min": 21, "max": 30, "step": 3}}, "samples": 2}"#,
     )
     .unwrap();
-    let why = refused(s.raise_caps(id, &renamed, "b").await.unwrap_err());
+    let why = refused(s.raise_caps(id, &renamed, Some("b")).await.unwrap_err());
     assert!(why.contains("names or pinned engines differ"), "{why}");
     s.cancel(id).await.unwrap();
-    let why = refused(s.raise_caps(id, &capped(30), "b").await.unwrap_err());
+    let why = refused(s.raise_caps(id, &capped(30), Some("b")).await.unwrap_err());
     assert!(why.contains("cancelled"), "{why}");
     assert!(s.has_key("a").await.unwrap(), "nothing changed");
 }

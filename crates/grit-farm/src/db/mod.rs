@@ -27,7 +27,6 @@ mod worker;
 mod workers;
 
 pub use checkpoints::StoredJob;
-pub use extend::CapRaised;
 pub use worker::Reported;
 
 /// A report of impact records, for the tests.

@@ -1,5 +1,5 @@
 //! Campaign endpoints, all under the submit token: submit, list, status, results, jobs,
-//! cancel and retry-failed.
+//! cancel, retry-failed and raise-caps.
 
 use std::collections::BTreeMap;
 
@@ -26,6 +26,7 @@ pub fn router() -> Router<AppState> {
         .route("/campaigns/{id}/jobs", get(campaign_jobs))
         .route("/campaigns/{id}/cancel", post(cancel_campaign))
         .route("/campaigns/{id}/retry-failed", post(retry_failed))
+        .route("/campaigns/{id}/raise-caps", post(raise_caps))
 }
 
 /// The campaign endpoints' part of the OpenAPI document.
@@ -37,7 +38,8 @@ pub fn router() -> Router<AppState> {
     campaign_results,
     campaign_jobs,
     cancel_campaign,
-    retry_failed
+    retry_failed,
+    raise_caps
 ))]
 pub struct Doc;
 
@@ -45,6 +47,25 @@ pub struct Doc;
 fn campaign_id(raw: &str) -> Result<Uuid> {
     raw.parse()
         .map_err(|_| Error::NotFound(format!("campaign {raw}")))
+}
+
+/// A campaign spec from a request body: 400 for what is not JSON, 422 naming the field for a
+/// rule broken.
+fn spec_of(body: &Bytes) -> Result<AnySpec> {
+    let text = std::str::from_utf8(body).map_err(|_| Error::BadRequest {
+        status: StatusCode::BAD_REQUEST,
+        message: "body is not UTF-8 JSON".into(),
+    })?;
+    AnySpec::from_json(text).map_err(|e| {
+        if e.field == "(json)" {
+            Error::BadRequest {
+                status: StatusCode::BAD_REQUEST,
+                message: format!("malformed JSON: {}", e.rule),
+            }
+        } else {
+            e.into()
+        }
+    })
 }
 
 /// Submits a campaign (the campaign spec of README.md and docs/api.md; `"scene": "jet"` for a
@@ -60,20 +81,7 @@ async fn create_campaign(
     headers: HeaderMap,
     body: Bytes,
 ) -> Result<(StatusCode, Json<CampaignCreated>)> {
-    let text = std::str::from_utf8(&body).map_err(|_| Error::BadRequest {
-        status: StatusCode::BAD_REQUEST,
-        message: "body is not UTF-8 JSON".into(),
-    })?;
-    let spec = AnySpec::from_json(text).map_err(|e| {
-        if e.field == "(json)" {
-            Error::BadRequest {
-                status: StatusCode::BAD_REQUEST,
-                message: format!("malformed JSON: {}", e.rule),
-            }
-        } else {
-            e.into()
-        }
-    })?;
+    let spec = spec_of(&body)?;
     let key = headers
         .get("idempotency-key")
         .map(|v| {
@@ -246,4 +254,25 @@ async fn retry_failed(
 ) -> Result<Json<JobsChanged>> {
     let jobs = s.store.retry_failed(campaign_id(&id)?).await?;
     Ok(Json(JobsChanged { jobs }))
+}
+
+/// Raises the caps (`until_steady.max`) of a campaign to those of the body, the campaign's
+/// spec with higher caps, and runs on every cell that had stopped at its old cap short of its
+/// rule (docs/erosion.md, "Raising the cap").
+#[utoipa::path(post, path = "/api/v1/campaigns/{id}/raise-caps", params(("id" = Uuid, Path)),
+    request_body(content = Object, description = "the campaign's spec with higher until_steady.max values"),
+    responses((status = 200, body = CapsRaised), (status = 400, body = ErrorBody), (status = 401),
+        (status = 404, body = ErrorBody),
+        (status = 409, body = ErrorBody, description = "another campaign's spec (what differs is named), a lower cap, or a cancelled campaign"),
+        (status = 422, body = ErrorBody)),
+    security(("submit_token" = [])))]
+async fn raise_caps(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    body: Bytes,
+) -> Result<Json<CapsRaised>> {
+    let id = campaign_id(&id)?;
+    let spec = spec_of(&body)?;
+    let raised = s.store.raise_caps(id, &spec, None).await?;
+    Ok(Json(CapsRaised { raised }))
 }
