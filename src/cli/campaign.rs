@@ -404,6 +404,14 @@ fn run_message(status: &CampaignStatus, units: &str) -> String {
     )
 }
 
+/// The coordinator's refusal of the spec in `file`, naming the file; other errors as they are.
+fn refused_spec(file: &Path, e: ClientError) -> anyhow::Error {
+    match e {
+        ClientError::Status { message, .. } => anyhow::anyhow!("{}: {message}", file.display()),
+        other => other.into(),
+    }
+}
+
 /// `grit submit`.
 pub async fn submit(a: SubmitArgs) -> anyhow::Result<ExitCode> {
     let text = read_spec_text(&a.file)?;
@@ -411,12 +419,7 @@ pub async fn submit(a: SubmitArgs) -> anyhow::Result<ExitCode> {
     let created = client
         .submit(&text, a.idempotency_key.as_deref())
         .await
-        .map_err(|e| match e {
-            ClientError::Status { message, .. } => {
-                anyhow::anyhow!("{}: {message}", a.file.display())
-            }
-            other => other.into(),
-        })?;
+        .map_err(|e| refused_spec(&a.file, e))?;
     eprintln!(
         "{} campaign: {} jobs, {} impacts",
         if created.created {
@@ -596,12 +599,7 @@ pub async fn raise_caps(a: RaiseCapsArgs) -> anyhow::Result<ExitCode> {
         .client()?
         .raise_caps(id, &text)
         .await
-        .map_err(|e| match e {
-            ClientError::Status { message, .. } => {
-                anyhow::anyhow!("{}: {message}", a.file.display())
-            }
-            other => other.into(),
-        })?;
+        .map_err(|e| refused_spec(&a.file, e))?;
     for cell in &r.raised {
         say!("{}", cell.describe());
     }
