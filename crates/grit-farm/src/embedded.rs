@@ -220,12 +220,16 @@ pub async fn run(
     // one's, and its charts would mix with them. The same campaign with higher caps runs on.
     if !store.has_key(&key).await? {
         if let Some(other) = store.list_campaigns().await?.first() {
+            let other_campaign = |why: String| EmbeddedError::OtherCampaign {
+                out: opts.out.clone(),
+                id: other.id,
+                why,
+            };
+            // Its samples must not mix engines, whatever this spec is to it.
             if let Some((pinned, own)) = mismatch(&store, other.id, spec).await? {
-                return Err(EmbeddedError::OtherEngine {
-                    out: opts.out.clone(),
-                    pinned,
-                    own,
-                });
+                return Err(other_campaign(format!(
+                    "it is pinned to engine {pinned} and this grit computes {own}"
+                )));
             }
             match store.raise_caps(other.id, spec, Some(&key)).await {
                 Ok(raised) => {
@@ -233,13 +237,7 @@ pub async fn run(
                         on_event(RunEvent::Note(r.describe()));
                     }
                 }
-                Err(crate::Error::Conflict(why)) => {
-                    return Err(EmbeddedError::OtherCampaign {
-                        out: opts.out.clone(),
-                        id: other.id,
-                        why,
-                    })
-                }
+                Err(crate::Error::Conflict(why)) => return Err(other_campaign(why)),
                 Err(e) => return Err(e.into()),
             }
         }
