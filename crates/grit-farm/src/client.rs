@@ -172,17 +172,21 @@ impl Client {
         Ok(())
     }
 
+    /// A POST of campaign spec text as it was written, so the coordinator names its fields.
+    fn post_spec(&self, path: &str, spec: &str) -> reqwest::RequestBuilder {
+        self.http
+            .post(self.url(path))
+            .header(reqwest::header::CONTENT_TYPE, "application/json")
+            .body(spec.to_string())
+    }
+
     /// Submits campaign spec text; `key` is sent as `Idempotency-Key`.
     pub async fn submit(
         &self,
         spec: &str,
         key: Option<&str>,
     ) -> Result<CampaignCreated, ClientError> {
-        let mut rb = self
-            .http
-            .post(self.url("/campaigns"))
-            .header(reqwest::header::CONTENT_TYPE, "application/json")
-            .body(spec.to_string());
+        let mut rb = self.post_spec("/campaigns", spec);
         if let Some(k) = key {
             rb = rb.header("Idempotency-Key", k);
         }
@@ -221,11 +225,7 @@ impl Client {
 
     /// Raises a campaign's `until_steady` caps to those of `spec`, its spec with higher caps.
     pub async fn raise_caps(&self, id: Uuid, spec: &str) -> Result<CapsRaised, ClientError> {
-        let rb = self
-            .http
-            .post(self.url(&format!("/campaigns/{id}/raise-caps")))
-            .header(reqwest::header::CONTENT_TYPE, "application/json")
-            .body(spec.to_string());
+        let rb = self.post_spec(&format!("/campaigns/{id}/raise-caps"), spec);
         Self::json(self.send(rb).await?).await
     }
 

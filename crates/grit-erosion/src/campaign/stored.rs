@@ -34,14 +34,6 @@ pub struct StoredCell {
     pub target_sem: Option<TargetSem>,
 }
 
-impl StoredCell {
-    /// Whether the samples may still be asked for more units, so the state after their last
-    /// unit must be kept.
-    pub fn units_may_grow(&self) -> bool {
-        self.until_steady.is_some_and(|u| self.units < u.max)
-    }
-}
-
 /// A stored cell with the records its samples reported: sample index to records in unit
 /// order, samples without a record left out.
 #[derive(Debug, Clone, PartialEq)]

@@ -136,20 +136,19 @@ impl Store {
             .get(0);
             // A cell whose last round still runs is judged under the new cap when it ends;
             // one that met its rule below the old cap stays as it is.
-            let at_rest = plan.units >= cap.from
-                && settle_cell(&mut tx, &*scene, &campaign, &plan, now).await?;
-            let units: i64 =
-                sqlx::query("SELECT units FROM cells WHERE campaign_id = ? AND cell_index = ?")
-                    .bind(&campaign)
-                    .bind(cell)
-                    .fetch_one(&mut *tx)
-                    .await?
-                    .get(0);
+            let step = if plan.units >= cap.from {
+                settle_cell(&mut tx, &*scene, &campaign, &plan, now).await?
+            } else {
+                None
+            };
             report.push(RaisedCell {
                 cell: cap.cell,
                 from: cap.from,
                 to: cap.to,
-                reopened_to: (at_rest && units as u32 > plan.units).then_some(units as u32),
+                reopened_to: match step {
+                    Some(NextStep::ExtendImpacts(to)) => Some(to),
+                    _ => None,
+                },
                 resumed: resumed as u32,
                 samples: plan.samples,
             });
@@ -180,8 +179,8 @@ struct Seeded {
 }
 
 /// After a job of cell `plan`, one with growth rules, completed: once every job of the cell
-/// is done, grows the cell as its scene decides or finishes it, and says so (`false`: jobs of
-/// the cell are still open). Runs inside the completing transaction, so a crash anywhere
+/// is done, grows the cell as its scene decides or finishes it, and returns that step (`None`:
+/// jobs of the cell are still open). Runs inside the completing transaction, so a crash anywhere
 /// leaves either the job still leased or the cell fully grown.
 pub(super) async fn settle_cell(
     tx: &mut Transaction<'static, Sqlite>,
@@ -189,7 +188,7 @@ pub(super) async fn settle_cell(
     campaign: &str,
     plan: &StoredCell,
     now: i64,
-) -> Result<bool> {
+) -> Result<Option<NextStep>> {
     let cell = plan.index as i64;
     let open: i64 = sqlx::query(
         "SELECT COUNT(*) FROM jobs WHERE campaign_id = ? AND cell_index = ? AND state != 'done'",
@@ -200,7 +199,7 @@ pub(super) async fn settle_cell(
     .await?
     .get(0);
     if open > 0 {
-        return Ok(false);
+        return Ok(None);
     }
     // A unit stored before its masses had columns is read from its record.
     let rows = sqlx::query(
@@ -296,7 +295,7 @@ pub(super) async fn settle_cell(
         .await?;
     }
     tracing::info!(campaign, cell, ?step, "cell assessed");
-    Ok(true)
+    Ok(Some(step))
 }
 
 /// Whether cell `plan`, assessed final, stopped at its cap short of its rule: under a higher

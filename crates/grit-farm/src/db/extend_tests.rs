@@ -381,10 +381,6 @@ async fn each_units_damage_added_is_stored_beside_its_masses_and_balances_the_ce
     assert!((b.ratio.unwrap() - 0.75).abs() < 1e-9, "{b:?}");
 }
 
-/// What judging a finished cell costs the writer, for a cell of 25 samples × 400 impacts:
-/// its last completion (which judges it) against the others, and the read of its units'
-/// masses from their columns against parsing every record. Run by hand, on an idle machine:
-/// `cargo test --release -p grit-farm --lib settle_cost -- --ignored --nocapture`.
 /// [`spec`]'s never-steady cell of 2 samples capped at `max`, for [`Store::raise_caps`].
 fn capped(max: u32) -> AnySpec {
     AnySpec::Impact(spec(
@@ -495,6 +491,10 @@ async fn only_higher_caps_of_the_same_campaign_are_raised() {
     assert!(s.has_key("a").await.unwrap(), "nothing changed");
 }
 
+/// What judging a finished cell costs the writer, for a cell of 25 samples × 400 impacts:
+/// its last completion (which judges it) against the others, and the read of its units'
+/// masses from their columns against parsing every record. Run by hand, on an idle machine:
+/// `cargo test --release -p grit-farm --lib settle_cost -- --ignored --nocapture`.
 #[tokio::test]
 #[ignore]
 async fn settle_cost() {
