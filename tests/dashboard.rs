@@ -275,9 +275,13 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
     let api = Api::new(&url);
 
     // Two angles × two samples × 20 impacts: enough for each sample's last-20 slope, so the
-    // erosion chart has a point with an error bar at each angle.
+    // erosion chart has a point with an error bar at each angle. Until steady with its cap at
+    // its start, so each cell stops at the cap and the note says how to raise it.
     let id = api
-        .submit(&campaign("dashboard-e2e", "[45, 90]", 2, 20))
+        .submit(&campaign("dashboard-e2e", "[45, 90]", 2, 20).replace(
+            r#""impacts": 20"#,
+            r#""impacts": {"until_steady": {"min": 20, "max": 20, "step": 10}}"#,
+        ))
         .await;
     let worker = start_worker(dir.path(), &url, "dash-worker", &[]);
     // While it runs, the worker is listed with the job it holds.
@@ -386,6 +390,10 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
         if !note.contains("Hollow points: not at steady state") || !note.contains(&shown) {
             fail(&format!("the note with the reason `{reason}`"));
         }
+        assert!(reason.starts_with("reached max 20 impacts"), "{reason}");
+    }
+    if !note.contains(&format!("grit raise-caps {id} SPEC.json")) {
+        fail("the hint that raising the cap runs the capped cells on");
     }
     if !dom.contains("dash-worker") {
         fail("the worker");

@@ -823,3 +823,102 @@ async fn until_steady_extends_samples_bit_for_bit() {
     let e = c.raise_caps(id, &spec).await.unwrap_err().to_string();
     assert!(e.contains("may only be raised, from 27 (got 25)"), "{e}");
 }
+
+/// `grit run` on a folder whose campaign is pinned to another engine: resuming it, or raising
+/// its caps, is refused (exit 2, both fingerprints named) and changes nothing there;
+/// `--engine-upgrade NEW` runs the spec afresh in NEW on this engine.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_folder_pinned_to_another_engine_is_refused_or_upgraded() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let capped = common::campaign("pin", "[60]", 1, 21).replace(
+        r#""impacts": 21"#,
+        r#""impacts": {"until_steady": {"min": 21, "max": 23, "step": 2}}"#,
+    );
+    let first = grit_run(dir.path(), &capped, "old", true);
+    let db = dir.path().join("old").join("grit.db");
+    let other = "0000000000000000";
+    let pool =
+        sqlx::SqlitePool::connect_with(sqlx::sqlite::SqliteConnectOptions::new().filename(&db))
+            .await
+            .unwrap();
+    sqlx::query("UPDATE campaigns SET engine = ?")
+        .bind(other)
+        .execute(&pool)
+        .await
+        .unwrap();
+    let stored = |pool: sqlx::SqlitePool| async move {
+        sqlx::query_scalar::<_, i64>("SELECT count(*) FROM units")
+            .fetch_one(&pool)
+            .await
+            .unwrap()
+    };
+    let units = stored(pool.clone()).await;
+    let own = grit_erosion::scene::engines::<grit_erosion::Scenes>().unwrap()["impact"].clone();
+
+    let raised = dir.path().join("raised.json");
+    std::fs::write(&raised, capped.replace(r#""max": 23"#, r#""max": 25"#)).unwrap();
+    let run = |spec: &Path, extra: &[&str]| {
+        Command::new(GRIT)
+            .args(["run", "--quiet", "--out"])
+            .arg(dir.path().join("old"))
+            .args(extra)
+            .arg(spec)
+            .output()
+            .unwrap()
+    };
+    for (spec, says) in [
+        (
+            dir.path().join("old.json"),
+            format!("pinned to engine {other}, and this grit computes {own}"),
+        ),
+        (
+            raised.clone(),
+            format!("it is pinned to engine {other} and this grit computes {own}"),
+        ),
+    ] {
+        let out = run(&spec, &[]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(&says), "{stderr}");
+    }
+    assert_eq!(
+        stored(pool.clone()).await,
+        units,
+        "nothing run in the old folder"
+    );
+    let caps: String = sqlx::query_scalar("SELECT spec FROM campaigns")
+        .fetch_one(&pool)
+        .await
+        .unwrap();
+    assert!(
+        caps.contains(r#""max":23"#) || caps.contains(r#""max": 23"#),
+        "{caps}"
+    );
+
+    let fresh = dir.path().join("new");
+    let out = run(
+        &dir.path().join("old.json"),
+        &["--raw", "--engine-upgrade", fresh.to_str().unwrap()],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "running it afresh in {} on engine {own}",
+            fresh.display()
+        )),
+        "{stderr}"
+    );
+    let upgraded: Value =
+        serde_json::from_str(&std::fs::read_to_string(fresh.join("results.json")).unwrap())
+            .unwrap();
+    assert_eq!(upgraded["engine"], own.as_str());
+    // Only the pin was another engine's, so the fresh run repeats the first one's bits.
+    assert_bitwise_equal(&raw_series(&upgraded), &raw_series(&first));
+    assert_eq!(
+        stored(pool).await,
+        units,
+        "the old folder is left as it was"
+    );
+}
