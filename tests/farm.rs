@@ -922,3 +922,69 @@ async fn a_folder_pinned_to_another_engine_is_refused_or_upgraded() {
         "the old folder is left as it was"
     );
 }
+
+/// `grit run --interim-every` writes the results so far to results.json while the campaign
+/// runs (unfinished cells partial), and the final results over them at the end.
+#[tokio::test(flavor = "multi_thread")]
+async fn grit_run_writes_interim_results_while_it_runs() {
+    let _g = SERIAL.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("interim.json");
+    std::fs::write(&spec, common::campaign("interim", "[45, 90]", 2, 6)).unwrap();
+    let out_dir = dir.path().join("out");
+    let results = out_dir.join("results.json");
+    let mut child = Command::new(GRIT)
+        .args(["run", "--quiet", "--workers", "1", "--threads", "1"])
+        .args(["--interim-every", "0.2", "--out"])
+        .arg(&out_dir)
+        .arg(&spec)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut interim: Option<Value> = None;
+    while child.try_wait().unwrap().is_none() {
+        if let Ok(text) = std::fs::read_to_string(&results) {
+            let v: Value = serde_json::from_str(&text).expect("written whole, never torn");
+            if v["partial"] == true && interim.is_none() {
+                interim = Some(v);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let interim = interim.expect("interim results while it ran");
+    let cells = interim["cells"].as_array().unwrap();
+    assert!(
+        cells
+            .iter()
+            .any(|c| c["samples_reported"].as_u64() > Some(0)),
+        "finished samples in the interim results: {interim}"
+    );
+    assert!(cells.iter().any(|c| c["partial"] == true), "{interim}");
+    assert!(stderr.contains("interim results ("), "{stderr}");
+    // `grit compare` reads them, saying which cells still ran.
+    let file = dir.path().join("interim-results.json");
+    std::fs::write(&file, interim.to_string()).unwrap();
+    let out = Command::new(GRIT)
+        .arg("compare")
+        .arg(&file)
+        .output()
+        .unwrap();
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(table.contains("note: interim results: "), "{table}");
+    let last: Value = serde_json::from_str(&std::fs::read_to_string(&results).unwrap()).unwrap();
+    assert_eq!(last["partial"], false);
+    // A cell complete in the interim results is the final one's.
+    for (a, b) in cells.iter().zip(last["cells"].as_array().unwrap()) {
+        if a["partial"] == false {
+            assert_eq!(a["erosion_mean"], b["erosion_mean"]);
+        }
+    }
+}

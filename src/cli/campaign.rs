@@ -49,6 +49,10 @@ pub struct RunArgs {
     /// Nothing is carried over: a campaign never mixes two engines' samples.
     #[arg(long, value_name = "NEW_DIR")]
     pub engine_upgrade: Option<PathBuf>,
+    /// While the campaign runs, write the results so far (unfinished cells marked partial)
+    /// to results.json at most every this many seconds, when jobs finished since.
+    #[arg(long, value_name = "SECONDS", default_value_t = 600.0, value_parser = crate::cli::seconds)]
+    pub interim_every: f64,
 }
 
 /// Where the coordinator is and how to authenticate: the client commands and `grit work`.
@@ -207,7 +211,9 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         checkpoint_every: a.checkpoint_every,
         raw: a.raw,
         commit: Some(env!("GRIT_COMMIT").to_string()),
+        interim_every: Some(Duration::from_secs_f64(a.interim_every)),
     };
+    let results_path = out.join("results.json");
     let stop = Stop::default();
     on_signals(stop.clone());
     let units = unit(spec.scene());
@@ -235,13 +241,21 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
                 );
             }
         }
-        // A hidden bar (no terminal, --quiet) prints nothing of its own.
-        RunEvent::Note(line) if bar.is_hidden() => eprintln!("{line}"),
-        RunEvent::Note(line) => bar.println(line),
+        RunEvent::Interim(results) => {
+            let (complete, cells) = results.cells_complete();
+            let line = match write_json(&results_path, results) {
+                Ok(()) => format!(
+                    "interim results ({complete} of {cells} cells complete) in {}",
+                    results_path.display()
+                ),
+                Err(e) => format!("interim results not written: {e:#}"),
+            };
+            note(&bar, line);
+        }
+        RunEvent::Note(line) => note(&bar, line),
     })
     .await?;
     bar.finish();
-    let results_path = out.join("results.json");
     write_json(&results_path, &outcome.results)?;
     eprintln!(
         "campaign {:?}; results in {}",
@@ -264,6 +278,16 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         CampaignState::Done => ExitCode::SUCCESS,
         _ => ExitCode::from(1),
     })
+}
+
+/// A line above the progress bar, or on its own where the bar is hidden (no terminal,
+/// `--quiet`) and would swallow it.
+fn note(bar: &ProgressBar, line: String) {
+    if bar.is_hidden() {
+        eprintln!("{line}");
+    } else {
+        bar.println(line);
+    }
 }
 
 /// One line per cell of the results on stdout: erosion for impacts, Cd, Cw and mass loss at T

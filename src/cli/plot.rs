@@ -106,6 +106,21 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
         let _ = writeln!(o, "{}", serde_json::to_string_pretty(&c)?);
     } else {
         let _ = write!(o, "{}", grit_erosion::models::compare::markdown(&c));
+        let running: Vec<String> = input
+            .results
+            .cells
+            .iter()
+            .filter(|c| c.partial)
+            .map(|c| format!("{}° {}", c.angle_deg, c.shape))
+            .collect();
+        if !running.is_empty() {
+            let _ = writeln!(
+                o,
+                "note: interim results: {} still running ({}); their rows are what their finished samples give so far",
+                running.len(),
+                running.join(", ")
+            );
+        }
         for n in window_notes.into_iter().chain(notes) {
             let _ = writeln!(o, "note: {n}");
         }

@@ -30,6 +30,9 @@ pub struct EmbeddedOptions {
     pub raw: bool,
     /// The commit this grit was built from, recorded with a new campaign.
     pub commit: Option<String>,
+    /// Results of the finished samples so far ([`RunEvent::Interim`]) at most this often,
+    /// whenever jobs finished since the last; `None`: only at the end.
+    pub interim_every: Option<Duration>,
 }
 
 /// Local workers and engine threads per worker for a campaign of `jobs` jobs on `cores`
@@ -62,6 +65,9 @@ pub enum RunEvent<'a> {
     Status(&'a CampaignStatus),
     /// A line worth showing: a failed job, a worker that stopped with an error.
     Note(String),
+    /// The results so far (cells still running marked `partial`), while the campaign runs:
+    /// a campaign of days can be looked at without stopping it.
+    Interim(&'a AnyResults),
 }
 
 /// What `grit run` produced.
@@ -297,9 +303,14 @@ pub async fn run(
     on_event(RunEvent::Started {
         impacts_total: created.impacts_total,
     });
+    let mut interim = Interim::new(opts.interim_every, &store.status(created.id).await?);
     let state = loop {
         let status = store.status(created.id).await?;
         on_event(RunEvent::Status(&status));
+        if !status.state.is_final() && interim.due(&status) {
+            let results = store.results_any(created.id, opts.raw).await?;
+            on_event(RunEvent::Interim(&results));
+        }
         if status.state.is_final() {
             if let Some(e) = &status.last_error {
                 on_event(RunEvent::Note(format!(
@@ -324,6 +335,36 @@ pub async fn run(
     let results = store.results_any(created.id, opts.raw).await?;
     running.stop().await;
     Ok(EmbeddedOutcome { state, results })
+}
+
+/// When [`run`] next reports interim results: once `every` has passed since the last report
+/// (or the start) and jobs finished since, so a campaign between jobs costs no aggregation.
+struct Interim {
+    every: Option<Duration>,
+    last: std::time::Instant,
+    done: u64,
+}
+
+impl Interim {
+    fn new(every: Option<Duration>, status: &CampaignStatus) -> Interim {
+        Interim {
+            every,
+            last: std::time::Instant::now(),
+            done: status.jobs.done,
+        }
+    }
+
+    fn due(&mut self, status: &CampaignStatus) -> bool {
+        let Some(every) = self.every else {
+            return false;
+        };
+        if status.jobs.done == self.done || self.last.elapsed() < every {
+            return false;
+        }
+        self.last = std::time::Instant::now();
+        self.done = status.jobs.done;
+        true
+    }
 }
 
 #[cfg(test)]

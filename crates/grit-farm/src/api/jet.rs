@@ -72,6 +72,17 @@ impl AnyResults {
         }
     }
 
+    /// Cells with all their samples, impacts or slices, and cells in all.
+    pub fn cells_complete(&self) -> (usize, usize) {
+        let count = |partial: &mut dyn Iterator<Item = bool>| {
+            partial.fold((0, 0), |(done, all), p| (done + usize::from(!p), all + 1))
+        };
+        match self {
+            AnyResults::Jet(r) => count(&mut r.results.cells.iter().map(|c| c.partial)),
+            AnyResults::Impact(r) => count(&mut r.results.cells.iter().map(|c| c.partial)),
+        }
+    }
+
     /// One warning line per cell whose rate is not a steady one.
     pub fn unsteady_warnings(&self) -> Vec<String> {
         match self {
