@@ -250,9 +250,9 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
                 ),
                 Err(e) => format!("interim results not written: {e:#}"),
             };
-            note(&bar, line);
+            progress::note(&bar, &line);
         }
-        RunEvent::Note(line) => note(&bar, line),
+        RunEvent::Note(line) => progress::note(&bar, &line),
     })
     .await?;
     bar.finish();
@@ -278,16 +278,6 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
         CampaignState::Done => ExitCode::SUCCESS,
         _ => ExitCode::from(1),
     })
-}
-
-/// A line above the progress bar, or on its own where the bar is hidden (no terminal,
-/// `--quiet`) and would swallow it.
-fn note(bar: &ProgressBar, line: String) {
-    if bar.is_hidden() {
-        eprintln!("{line}");
-    } else {
-        bar.println(line);
-    }
 }
 
 /// One line per cell of the results on stdout: erosion for impacts, Cd, Cw and mass loss at T

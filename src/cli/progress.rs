@@ -31,3 +31,13 @@ pub fn line(bar: &ProgressBar, line: &str) {
         bar.println(line);
     }
 }
+
+/// [`line`] for a message rather than an output row: above the bar, or on standard error where
+/// the bar is hidden (no terminal, `--quiet`) and would swallow it.
+pub fn note(bar: &ProgressBar, line: &str) {
+    if bar.is_hidden() {
+        eprintln!("{line}");
+    } else {
+        bar.println(line);
+    }
+}

@@ -303,7 +303,7 @@ pub async fn run(
     on_event(RunEvent::Started {
         impacts_total: created.impacts_total,
     });
-    let mut interim = Interim::new(opts.interim_every, &store.status(created.id).await?);
+    let mut interim = Interim::new(opts.interim_every, j.done);
     let state = loop {
         let status = store.status(created.id).await?;
         on_event(RunEvent::Status(&status));
@@ -346,11 +346,12 @@ struct Interim {
 }
 
 impl Interim {
-    fn new(every: Option<Duration>, status: &CampaignStatus) -> Interim {
+    /// Counting from now, with `done` jobs finished.
+    fn new(every: Option<Duration>, done: u64) -> Interim {
         Interim {
             every,
             last: std::time::Instant::now(),
-            done: status.jobs.done,
+            done,
         }
     }
 
