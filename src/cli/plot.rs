@@ -116,7 +116,7 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<ExitCode> {
         if !running.is_empty() {
             let _ = writeln!(
                 o,
-                "note: interim results: {} still running ({}); their rows are what their finished samples give so far",
+                "note: interim results: {} still running ({}); their rows, marked partial, are what their finished samples give so far",
                 running.len(),
                 running.join(", ")
             );

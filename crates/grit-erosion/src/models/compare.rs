@@ -44,6 +44,10 @@ pub struct Ratio {
     /// (`damage_balance`; `null`: one has no balance).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub balanced: Option<bool>,
+    /// Whether either cell is partial (samples or impacts short of its plan: still running in
+    /// an interim file), so its verdicts are not final.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
 }
 
 /// One row of the angle table: a cell normalised by its shape's 45° cell.
@@ -94,6 +98,9 @@ pub struct FitRow {
     /// Whether the cell's last window is balanced (`damage_balance`; `null`: no balance).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub balanced: Option<bool>,
+    /// Whether the cell is partial, so its verdicts are not final.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
 }
 
 /// One shape's angles against Oka's g(α) (eq. 35) with one scale fitted to all of them by
@@ -154,6 +161,9 @@ pub struct RepeatRow {
     /// Whether the cell's last window is balanced (`damage_balance`; `null`: no balance).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub balanced: Option<bool>,
+    /// Whether the cell is partial, so its verdicts are not final.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
     /// (erosion − the first file's) / √(s.e.² + the first file's s.e.²): independent samples.
     pub z_vs_first: Option<f64>,
 }
@@ -261,6 +271,7 @@ pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell>
                         erosion_sem: same.erosion_sem,
                         steady: steady(same),
                         balanced: balanced(same),
+                        partial: same.partial,
                         z_vs_first: match (c.erosion_mean, c.erosion_sem) {
                             (Some(a), Some(sa)) => match (same.erosion_mean, same.erosion_sem) {
                                 (Some(b), Some(sb)) if sa.hypot(sb) > 0.0 => {
@@ -338,6 +349,7 @@ fn ratio(num: &CellResult, den: &CellResult, reference: f64, tolerance: f64) -> 
         within_goal: deviation.map(|d| d.abs() <= tolerance),
         steady: both(steady(num), steady(den)),
         balanced: both(balanced(num), balanced(den)),
+        partial: num.partial || den.partial,
     }
 }
 
@@ -443,6 +455,7 @@ fn oka_fit(shape: &str, cells: &[&CellResult], g: impl Fn(f64) -> f64) -> Option
                 within_goal: deviation.abs() <= ANGLE_TOLERANCE,
                 steady: steady(c),
                 balanced: balanced(c),
+                partial: c.partial,
             }
         })
         .collect();
@@ -464,8 +477,12 @@ fn yes_no(v: Option<bool>, yes: &str, no: &str) -> String {
 }
 
 /// A cell's verdicts: the steady rule's, then, for a steady cell with a damage balance,
-/// whether its loss pays for the damage added (docs/erosion.md, *The damage balance*).
-fn verdict(steady: Option<bool>, balanced: Option<bool>) -> String {
+/// whether its loss pays for the damage added (docs/erosion.md, *The damage balance*). A
+/// partial cell has none yet: its rule looked at samples that are still running.
+fn verdict(steady: Option<bool>, balanced: Option<bool>, partial: bool) -> String {
+    if partial {
+        return "partial".into();
+    }
     match (steady, balanced) {
         (Some(true), Some(true)) => "steady, balanced".into(),
         (Some(true), Some(false)) => "steady, **unbalanced**".into(),
@@ -482,7 +499,7 @@ fn ratio_cells(r: &Ratio) -> [String; 6] {
             .map_or("–".into(), |d| format!("{:+.0} %", 100.0 * d)),
         num(r.z, 1),
         yes_no(r.within_goal, "yes", "**no**"),
-        verdict(r.steady, r.balanced),
+        verdict(r.steady, r.balanced, r.partial),
     ]
 }
 
@@ -570,7 +587,7 @@ pub fn markdown(c: &Comparison) -> String {
                     format!("{:+.0} %", 100.0 * r.deviation),
                     format!("{:.1}", r.z),
                     yes_no(Some(r.within_goal), "yes", "**no**"),
-                    verdict(r.steady, r.balanced),
+                    verdict(r.steady, r.balanced, r.partial),
                 ]
             }),
         );
@@ -629,7 +646,7 @@ pub fn markdown(c: &Comparison) -> String {
                         num(w.erosion_sem.map(|e| 1e3 * e), 2)
                     ),
                     num(w.z_vs_first, 1),
-                    verdict(w.steady, w.balanced),
+                    verdict(w.steady, w.balanced, w.partial),
                 ]
             }),
         );
@@ -723,6 +740,27 @@ mod tests {
         assert_eq!(
             fit.iter().map(|r| r.balanced).collect::<Vec<_>>(),
             [Some(true), Some(false), None, None]
+        );
+    }
+
+    #[test]
+    fn a_partial_cell_has_no_verdict_yet() {
+        // An interim file's running cell: its steady rule looked at unfinished samples.
+        let mut running = cell("hexagon", 90.0, 1e-3, 1e-4, false);
+        running.partial = true;
+        let cells = vec![cell("hexagon", 45.0, 1e-3, 1e-4, true), running];
+        let c = compare(&results(cells));
+        let partial: Vec<_> = c.angles.iter().map(|a| a.ratio.partial).collect();
+        assert_eq!(partial, [false, true]);
+        assert!(c.oka_fits[0].rows[1].partial);
+        let md = markdown(&c);
+        assert!(md.contains("| steady |"), "{md}");
+        assert!(md.contains("| partial |"), "{md}");
+        assert!(!md.contains("unsteady"), "{md}");
+        let v = serde_json::to_value(&c.angles[0].ratio).unwrap();
+        assert!(
+            v.get("partial").is_none(),
+            "a final cell's row keeps its old form: {v}"
         );
     }
 
