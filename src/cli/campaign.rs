@@ -170,6 +170,20 @@ fn fmt_eta(s: Option<f64>) -> String {
     })
 }
 
+/// The running jobs' replay of stored units, which the progress lines add since it keeps
+/// the count still and the rate unknown: empty when none replays.
+fn fmt_replay(s: &CampaignStatus) -> String {
+    s.replaying.map_or(String::new(), |r| {
+        format!(
+            "  replaying {} stored {} ({} job{})",
+            r.units_left,
+            unit(s.scene),
+            r.jobs,
+            if r.jobs == 1 { "" } else { "s" }
+        )
+    })
+}
+
 fn fmt_state(s: &CampaignState) -> String {
     format!("{s:?}").to_lowercase()
 }
@@ -407,14 +421,15 @@ fn run_message(status: &CampaignStatus, units: &str) -> String {
     });
     let j = &status.jobs;
     format!(
-        "{rate}  {eta}  jobs {}/{} done{}",
+        "{rate}  {eta}  jobs {}/{} done{}{}",
         j.done,
         j.done + j.queued + j.leased + j.failed + j.cancelled,
         if j.failed > 0 {
             format!(", {} failed", j.failed)
         } else {
             String::new()
-        }
+        },
+        fmt_replay(status)
     )
 }
 
@@ -480,7 +495,7 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         say!("{}", serde_json::to_string_pretty(&s)?);
     } else {
         say!(
-            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}",
+            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}{}",
             s.id,
             fmt_state(&s.state),
             s.impacts_done,
@@ -492,7 +507,8 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             s.jobs.failed,
             s.jobs.cancelled,
             s.rate_impacts_per_s.map_or("–".into(), |r| format!("{r:.3}/s")),
-            fmt_eta(s.eta_s)
+            fmt_eta(s.eta_s),
+            fmt_replay(&s)
         );
         say!(
             "engine {}",
@@ -541,11 +557,12 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
         total.set_length(s.impacts_total);
         total.set_position(s.impacts_done);
         total.set_message(format!(
-            "{}  rate {}  ETA {}",
+            "{}  rate {}  ETA {}{}",
             fmt_state(&s.state),
             s.rate_impacts_per_s
                 .map_or("–".into(), |r| format!("{r:.3}/s")),
-            fmt_eta(s.eta_s)
+            fmt_eta(s.eta_s),
+            fmt_replay(&s)
         ));
         while cells.len() < s.cells.len() {
             let c = &s.cells[cells.len()];

@@ -150,6 +150,10 @@ pub struct CampaignStatus {
     pub rate_impacts_per_s: Option<f64>,
     /// Seconds to finish at that rate; `null` when unknown.
     pub eta_s: Option<f64>,
+    /// Running jobs that are computing stored units again (resumed from an older checkpoint,
+    /// or from the start without one) before they can add new ones; left out when none is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replaying: Option<Replaying>,
     /// Per-cell progress, in cell order.
     pub cells: Vec<CellProgress>,
     /// The last error of any failed job.
@@ -171,6 +175,17 @@ pub struct CampaignStatus {
     /// an engine no running worker has.
     #[serde(default)]
     pub engine_seen: Option<bool>,
+}
+
+/// Replay of a campaign's running jobs: units already stored that their workers compute
+/// again, bit for bit, to rebuild a state no checkpoint kept. The campaign's count and rate
+/// stand still meanwhile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+pub struct Replaying {
+    /// Running jobs still behind their stored units.
+    pub jobs: u64,
+    /// Stored units those jobs have yet to compute again.
+    pub units_left: u64,
 }
 
 /// Job state (the `state` column of the jobs table).

@@ -12,7 +12,7 @@ use super::{
 };
 use crate::api::{
     AnyResults, CampaignCreated, CampaignState, CampaignStatus, CampaignSummary, CellProgress,
-    JobCounts, JobError, JobInfo, JobState,
+    JobCounts, JobError, JobInfo, JobState, Replaying,
 };
 use crate::error::{Error, Result};
 
@@ -278,6 +278,25 @@ impl Store {
             .get::<Option<i64>, _>("first")
             .filter(|_| n > 1)
             .map(|first| n as f64 / ((now - first).max(1000) as f64 / 1000.0));
+        // A running job is behind until its worker has reported its stored units again from
+        // where it resumed: its checkpoint, or the start without one (units_reported: the
+        // highest unit the lease has reported, stored or new).
+        let behind = sqlx::query(
+            "SELECT COUNT(*) AS jobs, COALESCE(SUM(behind), 0) AS units FROM (
+                 SELECT j.units_done - max(j.units_reported, COALESCE(k.units_done, 0)) AS behind
+                 FROM jobs j LEFT JOIN checkpoints k ON k.job_id = j.id
+                 WHERE j.campaign_id = ? AND j.state = 'leased') WHERE behind > 0",
+        )
+        .bind(&ids)
+        .fetch_one(&self.read)
+        .await?;
+        let replaying = match behind.get::<i64, _>("jobs") {
+            0 => None,
+            jobs => Some(Replaying {
+                jobs: jobs as u64,
+                units_left: behind.get::<i64, _>("units") as u64,
+            }),
+        };
         let cancelled = c.get::<Option<i64>, _>("cancelled_ms").is_some();
         let total_jobs =
             counts.queued + counts.leased + counts.done + counts.failed + counts.cancelled;
@@ -320,6 +339,7 @@ impl Store {
             jobs: counts,
             rate_impacts_per_s: rate,
             eta_s: eta,
+            replaying,
             cells,
             last_error,
             created_ms: c.get("created_ms"),

@@ -330,3 +330,80 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
     two.outcome.mass_loss_kg = 1e-9;
     assert_eq!(refused(two).await, "units[0].mass_loss_kg");
 }
+
+/// A job claimed again behind its stored impacts (a checkpoint older than them, or none) shows
+/// as replaying in the status until its worker has reported those impacts again, and no
+/// longer once it adds new ones; a claim starts the count afresh.
+#[tokio::test]
+async fn a_job_behind_its_stored_impacts_shows_its_replay_until_it_catches_up() {
+    use crate::api::Replaying;
+    use crate::checkpoint::CheckpointBytes;
+    use crate::loadtest::placeholder_record;
+
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let spec = CampaignSpec::from_json(
+        &TINY
+            .replace(r#""samples": 2"#, r#""samples": 1"#)
+            .replace(r#""impacts": 2"#, r#""impacts": 20"#),
+    )
+    .unwrap();
+    let id = s.create_campaign(&spec, None).await.unwrap().id;
+    let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
+    let records: Vec<_> = (1..=20)
+        .map(|k| placeholder_record(k, grain, 1e-7 * f64::from(k)))
+        .collect();
+    let replaying = |st: crate::api::CampaignStatus| st.replaying;
+
+    let j = s.claim("w").await.unwrap().unwrap();
+    assert_eq!(replaying(s.status(id).await.unwrap()), None, "a fresh job");
+    let ckpt = CheckpointBytes::new(4, vec![1; 8]);
+    s.heartbeat(
+        j.job_id,
+        j.lease_id,
+        imp(&records[..4]).with_checkpoint(Some(ckpt)),
+    )
+    .await
+    .unwrap();
+    s.heartbeat(j.job_id, j.lease_id, imp(&records[4..10]))
+        .await
+        .unwrap();
+    assert_eq!(
+        replaying(s.status(id).await.unwrap()),
+        None,
+        "adding new ones"
+    );
+    s.release(j.job_id, j.lease_id, imp(&[])).await.unwrap();
+
+    // Resumed from the checkpoint at 4: impacts 5–10 are stored and run again.
+    let again = s.claim("w").await.unwrap().unwrap();
+    assert_eq!(again.impacts_done, 10);
+    let left = |n| {
+        Some(Replaying {
+            jobs: 1,
+            units_left: n,
+        })
+    };
+    assert_eq!(replaying(s.status(id).await.unwrap()), left(6));
+    s.heartbeat(again.job_id, again.lease_id, imp(&records[4..7]))
+        .await
+        .unwrap();
+    assert_eq!(replaying(s.status(id).await.unwrap()), left(3));
+    let beat = s
+        .heartbeat(again.job_id, again.lease_id, imp(&records[7..12]))
+        .await
+        .unwrap();
+    assert_eq!(beat.impacts_done, 12);
+    assert_eq!(replaying(s.status(id).await.unwrap()), None, "caught up");
+
+    // The next lease is behind again: its own reports, not the last lease's, count.
+    s.release(again.job_id, again.lease_id, imp(&[]))
+        .await
+        .unwrap();
+    let third = s.claim("w").await.unwrap().unwrap();
+    assert_eq!(replaying(s.status(id).await.unwrap()), left(8));
+    s.complete(third.job_id, third.lease_id, imp(&records[4..]))
+        .await
+        .unwrap();
+    assert_eq!(replaying(s.status(id).await.unwrap()), None, "done");
+}

@@ -392,7 +392,7 @@ pub(super) async fn apply_claim(
     // (migrations/0011_queue_by_round.sql, 0012_queue_by_cell.sql).
     let Some(r) = sqlx::query(
         "UPDATE jobs SET state = 'leased', lease_id = ?1, worker = ?2, lease_expires_ms = ?3,
-                         updated_ms = ?4,
+                         updated_ms = ?4, units_reported = 0,
                          engine = (SELECT coalesce(json_extract(?5, '$.\"' || c.scene || '\"'),
                                                    json_extract(?5, '$.\"*\"'))
                                    FROM campaigns c WHERE c.id = jobs.campaign_id)
@@ -468,12 +468,18 @@ pub(super) async fn apply_heartbeat(
 ) -> Result<HeartbeatResponse> {
     let Report { now, done, .. } = report(tx, job_id, lease, units, checkpoint).await?;
     let expires = now + lease_ttl.as_millis() as i64;
+    // Stored or new, the highest unit this lease has reported: below `units_done`, the worker
+    // is still computing stored units again (the status's `replaying`).
+    let reported = units.rows.iter().map(|(n, _)| *n).max().unwrap_or(0);
     sqlx::query(
-        "UPDATE jobs SET lease_expires_ms = ?, units_done = ?, updated_ms = ? WHERE id = ?",
+        "UPDATE jobs SET lease_expires_ms = ?, units_done = ?, updated_ms = ?,
+                         units_reported = max(units_reported, ?)
+         WHERE id = ?",
     )
     .bind(expires)
     .bind(done as i64)
     .bind(now)
+    .bind(reported as i64)
     .bind(job_id)
     .execute(&mut **tx)
     .await?;
