@@ -13,6 +13,16 @@ use crate::error::Error;
 const TINY: &str = r#"{"angles_deg": [90], "shapes": ["hexagon"], "samples": 2, "impacts": 2,
     "allow_short_samples": true, "spacing_m": 25e-6}"#;
 
+/// TINY with one sample of `impacts` impacts.
+fn one_sample(impacts: u32) -> CampaignSpec {
+    CampaignSpec::from_json(
+        &TINY
+            .replace(r#""samples": 2"#, r#""samples": 1"#)
+            .replace(r#""impacts": 2"#, &format!(r#""impacts": {impacts}"#)),
+    )
+    .unwrap()
+}
+
 async fn store(dir: &Path, ttl_ms: u64) -> Store {
     Store::open(&dir.join("t.db"), Duration::from_millis(ttl_ms), 2)
         .await
@@ -204,12 +214,7 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
 
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path(), 60_000).await;
-    let spec = CampaignSpec::from_json(
-        &TINY
-            .replace(r#""samples": 2"#, r#""samples": 1"#)
-            .replace(r#""impacts": 2"#, r#""impacts": 400"#),
-    )
-    .unwrap();
+    let spec = one_sample(400);
     s.create_campaign(&spec, None).await.unwrap();
     let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
     let records: Vec<_> = (1..=400)
@@ -342,12 +347,7 @@ async fn a_job_behind_its_stored_impacts_shows_its_replay_until_it_catches_up() 
 
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path(), 60_000).await;
-    let spec = CampaignSpec::from_json(
-        &TINY
-            .replace(r#""samples": 2"#, r#""samples": 1"#)
-            .replace(r#""impacts": 2"#, r#""impacts": 20"#),
-    )
-    .unwrap();
+    let spec = one_sample(20);
     let id = s.create_campaign(&spec, None).await.unwrap().id;
     let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
     let records: Vec<_> = (1..=20)
