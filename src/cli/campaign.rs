@@ -170,6 +170,17 @@ fn fmt_eta(s: Option<f64>) -> String {
     })
 }
 
+/// `rate …  ETA …` of `grit status` and its `--watch`, with the running jobs' replay.
+fn fmt_rate_eta(s: &CampaignStatus) -> String {
+    format!(
+        "rate {}  ETA {}{}",
+        s.rate_impacts_per_s
+            .map_or("–".into(), |r| format!("{r:.3}/s")),
+        fmt_eta(s.eta_s),
+        fmt_replay(s)
+    )
+}
+
 /// The running jobs' replay of stored units, which the progress lines add since it keeps
 /// the count still and the rate unknown: empty when none replays.
 fn fmt_replay(s: &CampaignStatus) -> String {
@@ -495,7 +506,7 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         say!("{}", serde_json::to_string_pretty(&s)?);
     } else {
         say!(
-            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  rate {}  ETA {}{}",
+            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  {}",
             s.id,
             fmt_state(&s.state),
             s.impacts_done,
@@ -506,9 +517,7 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             s.jobs.done,
             s.jobs.failed,
             s.jobs.cancelled,
-            s.rate_impacts_per_s.map_or("–".into(), |r| format!("{r:.3}/s")),
-            fmt_eta(s.eta_s),
-            fmt_replay(&s)
+            fmt_rate_eta(&s)
         );
         say!(
             "engine {}",
@@ -556,14 +565,7 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
         };
         total.set_length(s.impacts_total);
         total.set_position(s.impacts_done);
-        total.set_message(format!(
-            "{}  rate {}  ETA {}{}",
-            fmt_state(&s.state),
-            s.rate_impacts_per_s
-                .map_or("–".into(), |r| format!("{r:.3}/s")),
-            fmt_eta(s.eta_s),
-            fmt_replay(&s)
-        ));
+        total.set_message(format!("{}  {}", fmt_state(&s.state), fmt_rate_eta(&s)));
         while cells.len() < s.cells.len() {
             let c = &s.cells[cells.len()];
             let prefix = match (c.angle_deg, &c.shape) {
