@@ -424,15 +424,10 @@ fn run_message(status: &CampaignStatus, units: &str) -> String {
     let rate = status
         .rate_impacts_per_s
         .map_or("rate –".to_string(), |r| format!("{r:.3} {units}/s"));
-    let eta = status.eta_s.map_or("ETA –".to_string(), |s| {
-        format!(
-            "ETA {}",
-            indicatif::HumanDuration(Duration::from_secs_f64(s))
-        )
-    });
     let j = &status.jobs;
     format!(
-        "{rate}  {eta}  jobs {}/{} done{}{}",
+        "{rate}  ETA {}  jobs {}/{} done{}{}",
+        fmt_eta(status.eta_s),
         j.done,
         j.done + j.queued + j.leased + j.failed + j.cancelled,
         if j.failed > 0 {
