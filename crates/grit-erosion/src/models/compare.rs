@@ -166,6 +166,10 @@ pub struct RepeatRow {
     pub partial: bool,
     /// (erosion − the first file's) / √(s.e.² + the first file's s.e.²): independent samples.
     pub z_vs_first: Option<f64>,
+    /// erosion / the first file's: with `z_vs_first`, whether a rate holds under refinement
+    /// (seed section 3.1; issue 40 asks for 10 % and 1.5 combined s.e.).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio_vs_first: Option<f64>,
 }
 
 /// A cell (shape, angle and swept values) found in two or more results files: the same cell
@@ -279,6 +283,10 @@ pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell>
                                 }
                                 _ => None,
                             },
+                            _ => None,
+                        },
+                        ratio_vs_first: match (c.erosion_mean, same.erosion_mean) {
+                            (Some(a), Some(b)) if a > 0.0 => Some(b / a),
                             _ => None,
                         },
                     })
@@ -620,7 +628,7 @@ pub fn markdown(c: &Comparison) -> String {
     for r in &c.repeated {
         let _ = writeln!(
             s,
-            "\n{} at {}° in {} files (z: the difference from the first file's erosion over both standard errors):\n",
+            "\n{} at {}° in {} files (ratio: erosion over the first file's; z: their difference over both standard errors):\n",
             r.shape,
             r.angle_deg,
             r.rows.len()
@@ -632,6 +640,7 @@ pub fn markdown(c: &Comparison) -> String {
                 "particles per Dg",
                 "samples",
                 "erosion (mg/g) ± s.e.",
+                "ratio to the first",
                 "z against the first",
                 "cell",
             ],
@@ -645,6 +654,7 @@ pub fn markdown(c: &Comparison) -> String {
                         num(w.erosion.map(|e| 1e3 * e), 2),
                         num(w.erosion_sem.map(|e| 1e3 * e), 2)
                     ),
+                    num(w.ratio_vs_first, 2),
                     num(w.z_vs_first, 1),
                     verdict(w.steady, w.balanced, w.partial),
                 ]
@@ -891,12 +901,14 @@ mod tests {
         assert_eq!(r.rows[0].z_vs_first, Some(0.0));
         // 0.5e-3 apart over √(0.3² + 0.4²) = 0.5e-3: one combined standard error.
         assert!((r.rows[1].z_vs_first.unwrap() - 1.0).abs() < 1e-9);
+        assert_eq!(r.rows[0].ratio_vs_first, Some(1.0));
+        assert!((r.rows[1].ratio_vs_first.unwrap() - 3.5 / 3.0).abs() < 1e-12);
         assert_eq!(r.rows[1].steady, Some(false));
         let mut c = compare(&coarse);
         c.repeated = rep;
         let md = markdown(&c);
         assert!(
-            md.contains("| b.json | 24.0 | 10 | 3.50 ± 0.40 | 1.0 | **unsteady** |"),
+            md.contains("| b.json | 24.0 | 10 | 3.50 ± 0.40 | 1.17 | 1.0 | **unsteady** |"),
             "{md}"
         );
     }
