@@ -138,6 +138,12 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     assert!(out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("is not at steady state"), "{stderr}");
+    // One line per cell under the campaign's line.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("\n  60.0° hexagon  2/2 samples  40/40 impacts\n"),
+        "{stdout}"
+    );
     // Both workers took part (one job each, claimed in parallel).
     assert!(_w1.log_text().contains("job complete") && _w2.log_text().contains("job complete"));
 }

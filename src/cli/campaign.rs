@@ -9,7 +9,7 @@ use anyhow::Context;
 use clap::Args;
 use grit_erosion::campaign::{AnySpec, Scene};
 use grit_erosion::CampaignResults;
-use grit_farm::api::{AnyResults, CampaignState, CampaignStatus};
+use grit_farm::api::{AnyResults, CampaignState, CampaignStatus, CellProgress};
 use grit_farm::embedded::{self, EmbeddedOptions, RunEvent};
 use grit_farm::worker::Stop;
 use grit_farm::{Client, ClientError};
@@ -193,6 +193,19 @@ fn fmt_replay(s: &CampaignStatus) -> String {
             if r.jobs == 1 { "" } else { "s" }
         )
     })
+}
+
+/// A cell as `grit status` names it: angle and shape with any swept values, or its index
+/// where the scene has no angle (the jet).
+fn cell_label(s: &CampaignStatus, c: &CellProgress) -> String {
+    let mut label = match (c.angle_deg, &c.shape) {
+        (Some(angle), Some(shape)) => format!("{angle:.1}° {shape}"),
+        _ => format!("{} cell {} ({})", s.scene.as_str(), c.cell, unit(s.scene)),
+    };
+    for (k, v) in &c.swept {
+        label.push_str(&format!(", {k} {v}"));
+    }
+    label
 }
 
 fn fmt_state(s: &CampaignState) -> String {
@@ -520,6 +533,17 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
                 .as_deref()
                 .unwrap_or("(not pinned: created before engine pins)")
         );
+        for c in &s.cells {
+            say!(
+                "  {}  {}/{} samples  {}/{} {}",
+                cell_label(&s, c),
+                c.samples_done,
+                c.samples_total,
+                c.impacts_done,
+                c.impacts_total,
+                unit(s.scene)
+            );
+        }
         say_last_error(&s);
     }
     if let Some(warning) = engine_warning(&s) {
@@ -563,10 +587,7 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
         total.set_message(format!("{}  {}", fmt_state(&s.state), fmt_rate_eta(&s)));
         while cells.len() < s.cells.len() {
             let c = &s.cells[cells.len()];
-            let prefix = match (c.angle_deg, &c.shape) {
-                (Some(angle), Some(shape)) => format!("{angle:.1}° {shape}"),
-                _ => format!("{} cell {} ({})", s.scene.as_str(), c.cell, unit(s.scene)),
-            };
+            let prefix = cell_label(&s, c);
             cells.push(multi.add(progress::bar(c.impacts_total, &prefix, true)));
         }
         for (bar, c) in cells.iter().zip(&s.cells) {
