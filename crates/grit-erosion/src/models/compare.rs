@@ -167,7 +167,7 @@ pub struct RepeatRow {
     /// (erosion − the first file's) / √(s.e.² + the first file's s.e.²): independent samples.
     pub z_vs_first: Option<f64>,
     /// erosion / the first file's: with `z_vs_first`, whether a rate holds under refinement
-    /// (seed section 3.1; issue 40 asks for 10 % and 1.5 combined s.e.).
+    /// (seed section 3.1; the target in docs/design.md is 10 % and 1.5 combined s.e.).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ratio_vs_first: Option<f64>,
 }
