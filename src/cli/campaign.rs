@@ -170,14 +170,14 @@ fn fmt_eta(s: Option<f64>) -> String {
     })
 }
 
-/// `rate …  ETA …` of `grit status` and its `--watch`, with the running jobs' replay.
-fn fmt_rate_eta(s: &CampaignStatus) -> String {
+/// `rate … units/s  ETA …` of `grit run`'s bar, `grit status` and its `--watch`, in the
+/// campaign's progress `units` (impacts or slices).
+fn fmt_rate_eta(s: &CampaignStatus, units: &str) -> String {
     format!(
-        "rate {}  ETA {}{}",
+        "rate {}  ETA {}",
         s.rate_impacts_per_s
-            .map_or("–".into(), |r| format!("{r:.3}/s")),
-        fmt_eta(s.eta_s),
-        fmt_replay(s)
+            .map_or("–".into(), |r| format!("{r:.3} {units}/s")),
+        fmt_eta(s.eta_s)
     )
 }
 
@@ -431,16 +431,12 @@ async fn warn_unsteady_remote(client: &Client, id: Uuid, finished: bool) {
     }
 }
 
-/// The bar's message while `grit run` runs: rate in the campaign's progress `units` (impacts
-/// or slices) per second, ETA and jobs done.
+/// The bar's message while `grit run` runs: rate, ETA and jobs done.
 fn run_message(status: &CampaignStatus, units: &str) -> String {
-    let rate = status
-        .rate_impacts_per_s
-        .map_or("rate –".to_string(), |r| format!("{r:.3} {units}/s"));
     let j = &status.jobs;
     format!(
-        "{rate}  ETA {}  jobs {}/{} done{}{}",
-        fmt_eta(status.eta_s),
+        "{}  jobs {}/{} done{}{}",
+        fmt_rate_eta(status, units),
         j.done,
         j.done + j.queued + j.leased + j.failed + j.cancelled,
         if j.failed > 0 {
@@ -514,7 +510,7 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         say!("{}", serde_json::to_string_pretty(&s)?);
     } else {
         say!(
-            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  {}",
+            "{}  {}  {}/{} {}  jobs: {} queued, {} leased, {} done, {} failed, {} cancelled  {}{}",
             s.id,
             fmt_state(&s.state),
             s.impacts_done,
@@ -525,7 +521,8 @@ pub async fn status(a: StatusArgs) -> anyhow::Result<ExitCode> {
             s.jobs.done,
             s.jobs.failed,
             s.jobs.cancelled,
-            fmt_rate_eta(&s)
+            fmt_rate_eta(&s, unit(s.scene)),
+            fmt_replay(&s)
         );
         say!(
             "engine {}",
@@ -584,7 +581,12 @@ async fn watch(client: &Client, id: Uuid) -> anyhow::Result<ExitCode> {
         };
         total.set_length(s.impacts_total);
         total.set_position(s.impacts_done);
-        total.set_message(format!("{}  {}", fmt_state(&s.state), fmt_rate_eta(&s)));
+        total.set_message(format!(
+            "{}  {}{}",
+            fmt_state(&s.state),
+            fmt_rate_eta(&s, unit(s.scene)),
+            fmt_replay(&s)
+        ));
         while cells.len() < s.cells.len() {
             let c = &s.cells[cells.len()];
             let prefix = cell_label(&s, c);
