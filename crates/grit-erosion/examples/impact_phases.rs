@@ -10,8 +10,10 @@ use grit_erosion::{ImpactParams, Sample};
 use grit_sph::World;
 use std::time::Instant;
 
-/// What the observer keeps: the last step in contact and the first after it with the grain
-/// moving up, with the mass removed and the damage added by each.
+/// What the observer keeps: the first and last steps in contact, the contact episodes, and the
+/// first step after the last contact with the grain moving up, with the mass removed and the
+/// damage added by each.
+#[derive(Default)]
 struct Trace {
     first_touch: u64,
     damage_at_first_touch: f64,
@@ -27,6 +29,8 @@ struct Trace {
     damage_at_away: f64,
 }
 
+/// The surface's damage stock Σ m D over all its particles, the fixed band included (the
+/// record's `damage_stock` leaves the band out; the band's share is about 0.1 %).
 fn damage_of(world: &World) -> f64 {
     let p = world.particles();
     (0..p.len())
@@ -58,23 +62,8 @@ fn main() {
                 settle_fraction: settle,
                 ..base.params().clone()
             };
-            let mut s = Sample::from_checkpoint(&bytes)
-                .and_then(|s| s.with_params(params))
-                .expect("params");
-            let mut tr = Trace {
-                first_touch: 0,
-                damage_at_first_touch: 0.0,
-                episodes: 0,
-                touching_steps: 0,
-                first_end: 0,
-                removed_at_first_end: 0.0,
-                last_touch: 0,
-                first_away: None,
-                removed_at_touch: 0.0,
-                damage_at_touch: 0.0,
-                removed_at_away: 0.0,
-                damage_at_away: 0.0,
-            };
+            let mut s = base.clone().with_params(params).expect("params");
+            let mut tr = Trace::default();
             // The first observed step follows the skipped flight; steps count from there, as
             // the record's do.
             let mut start: Option<(u64, f64)> = None;

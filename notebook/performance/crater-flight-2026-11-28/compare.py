@@ -6,10 +6,14 @@ resumed from the campaign's checkpoints by another binary (sJ.json files of `gri
 usage: python3 compare.py "file:DB?mode=ro" CELL DIR LO HI
 """
 import json
-import math
 import os
 import sqlite3
+import statistics as st
 import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "erosion"))
+from balance_interim import se  # noqa: E402
 
 db, cell, d, lo, hi = sys.argv[1], int(sys.argv[2]), sys.argv[3], int(sys.argv[4]), int(sys.argv[5])
 con = sqlite3.connect(db, uri=True)
@@ -28,10 +32,7 @@ def window(recs):
 
 
 def mean_se(xs):
-    n = len(xs)
-    m = sum(xs) / n
-    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1)) if n > 1 else float("nan")
-    return m, sd / math.sqrt(n)
+    return st.mean(xs), se(xs)
 
 
 rows = []
