@@ -5,7 +5,7 @@
 //! D = 1) by each point; then the same impact with each settle fraction given, from the same
 //! surface. Usage:
 //! `impact_phases SETTLE[,SETTLE…] CHECKPOINT…` (settle fractions in (0, 1); `-` for none).
-use grit_erosion::impact::{GRAIN_BODY, SURFACE_BODY};
+use grit_erosion::impact::{damage_stock, GRAIN_BODY, SURFACE_BODY};
 use grit_erosion::{ImpactParams, Sample};
 use grit_sph::World;
 use std::time::Instant;
@@ -27,16 +27,6 @@ struct Trace {
     damage_at_touch: f64,
     removed_at_away: f64,
     damage_at_away: f64,
-}
-
-/// The surface's damage stock Σ m D over all its particles, the fixed band included (the
-/// record's `damage_stock` leaves the band out; the band's share is about 0.1 %).
-fn damage_of(world: &World) -> f64 {
-    let p = world.particles();
-    (0..p.len())
-        .filter(|&i| p.body[i] as usize == SURFACE_BODY)
-        .map(|i| p.mass[i] * p.damage[i])
-        .sum()
 }
 
 fn main() {
@@ -68,9 +58,10 @@ fn main() {
             // the record's do.
             let mut start: Option<(u64, f64)> = None;
             let mut observe = |w: &World| {
-                // Removed particles are failed ones (D = 1): their mass is damage added too.
+                // Damage added as the record counts it: the surface's free particles (the grain
+                // is rigid and carries none), and removed particles are failed ones (D = 1).
                 let removed = w.bodies()[SURFACE_BODY].removed_mass_kg_m;
-                let d = damage_of(w) + removed;
+                let d = damage_stock(w.particles()) + removed;
                 let (s0, d0) = *start.get_or_insert((w.steps() - 1, d));
                 let touching = w.contact_forces().iter().any(|f| f.x != 0.0 || f.y != 0.0);
                 let up = w.bodies()[GRAIN_BODY]
