@@ -5,6 +5,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use grit_erosion::impact::balance::history;
 use grit_erosion::models::oka::{ModifiedOkaModel, OkaModel, ShapeExponents, ShapeReference};
 use grit_erosion::{
     aggregate_campaign, CellInput, Impact, ImpactOutcome, ImpactRecord, SampleInput, Shape,
@@ -305,6 +306,106 @@ fn unsteady_cells_are_drawn_hollow_with_a_note() {
     assert!(stdout.contains("(not at steady state)"), "{stdout}");
     assert!(stdout.contains("Hollow markers: 1 of 18 cells"), "{stdout}");
     check_images(dir.path());
+}
+
+/// A two-cell results file whose raw series carry the damage each impact added: 4 samples of
+/// 100 impacts adding 4 mg/g of damage per impact while their loss climbs from 0 to 4 mg/g over
+/// the first 60 impacts (with ±20 % noise) and stays there.
+fn balance_results() -> (serde_json::Value, Vec<Vec<SampleInput>>) {
+    let mut lcg = Lcg(11);
+    let mut noise = move || lcg.next_unit() * 2.0 - 1.0;
+    let (mut cells, mut raw, mut inputs) = (Vec::new(), Vec::new(), Vec::new());
+    for (cell, angle) in [45.0, 90.0].into_iter().enumerate() {
+        let mut samples = Vec::new();
+        for sample in 0..4u32 {
+            let records: Vec<ImpactRecord> = (1..=100u32)
+                .map(|k| {
+                    let grain = 1.2e-4;
+                    let rate = 4e-3 * (k as f64 / 60.0).min(1.0) * (1.0 + 0.2 * noise());
+                    let damage = 4e-3 * grain * (1.0 + 0.05 * noise());
+                    ImpactRecord {
+                        impact: k,
+                        grain_mass_kg: grain,
+                        mass_loss_kg: grain * rate,
+                        orientation_rad: 0.0,
+                        aim_x_m: 0.0,
+                        outcome: ImpactOutcome {
+                            mass_loss_kg: grain * rate,
+                            removed_particles: 0,
+                            detached_kg: 0.0,
+                            detached_particles: 0,
+                            sim_time_s: 1e-6,
+                            steps: 1000,
+                            rebound_ratio: 0.5,
+                            settled: true,
+                            damage_added_kg: Some(damage),
+                        },
+                    }
+                })
+                .collect();
+            samples.push(SampleInput {
+                sample,
+                impacts: records.iter().map(ImpactRecord::impact).collect(),
+            });
+            raw.push(serde_json::json!({
+                "cell": cell, "sample": sample, "seed": sample, "state": "done",
+                "impacts": records,
+            }));
+        }
+        inputs.push(samples.clone());
+        cells.push(CellInput {
+            angle_deg: angle,
+            shape: "hexagon".to_string(),
+            swept: Default::default(),
+            planned_samples: 4,
+            planned_impacts: 100,
+            samples,
+        });
+    }
+    let mut v = serde_json::to_value(aggregate_campaign(&cells, SLOPE_WINDOW).unwrap()).unwrap();
+    v["raw"] = serde_json::Value::Array(raw);
+    (v, inputs)
+}
+
+#[test]
+fn plot_draws_each_cells_approach_to_its_damage_balance() {
+    let (v, inputs) = balance_results();
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("results.json");
+    std::fs::write(&path, v.to_string()).unwrap();
+    let (dir, stdout) = plot(&path);
+    let files = stems(dir.path());
+    assert_has(&files, "damage_balance_c00_45deg_hexagon");
+    assert_has(&files, "damage_balance_c01_90deg_hexagon");
+    check_images(dir.path());
+    for (i, name) in ["c00_45deg", "c01_90deg"].iter().enumerate() {
+        let svg = std::fs::read_to_string(
+            dir.path()
+                .join(format!("damage_balance_{name}_hexagon.svg")),
+        )
+        .unwrap();
+        // One loss marker per window, filled exactly where the window is balanced.
+        let h = history(&inputs[i].iter().collect::<Vec<_>>());
+        assert_eq!(h.len(), 5);
+        let balanced = h.iter().filter(|w| w.balance.balanced).count();
+        // The loss climbs for 60 impacts: the first windows are short of the floor.
+        assert!(!h[0].balance.balanced && !h[1].balance.balanced, "{h:?}");
+        assert!(balanced >= 1, "{h:?}");
+        assert_eq!(circles(&svg, 4, "#1F77B4", false), balanced, "{name}");
+        assert_eq!(circles(&svg, 4, "#1F77B4", true), 5 - balanced, "{name}");
+        assert!(svg.contains("the balance"), "{name}: floor's legend");
+        assert!(
+            svg.contains("4 samples in every window"),
+            "{name}: samples note"
+        );
+    }
+    // A file without damage in its records says why it has no such chart.
+    let (_dir, stdout_quick) = plot(&data("quick-raw-results.json"));
+    assert!(
+        stdout_quick.contains("no damage-balance chart"),
+        "{stdout_quick}"
+    );
+    assert!(!stdout.contains("no damage-balance chart"), "{stdout}");
 }
 
 #[test]

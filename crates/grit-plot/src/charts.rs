@@ -124,14 +124,7 @@ fn any_unsteady(mut steady: impl Iterator<Item = Option<bool>>) -> bool {
 fn sample_curve(r: &RawSeries) -> Vec<(f64, f64)> {
     let mut impacts = r.impacts.clone();
     impacts.sort_by_key(|m| m.impact);
-    let impacts: Vec<Impact> = impacts
-        .iter()
-        .map(|m| Impact {
-            grain_mass_kg: m.grain_mass_kg,
-            mass_loss_kg: m.mass_loss_kg,
-            damage_added_kg: None,
-        })
-        .collect();
+    let impacts: Vec<Impact> = impacts.iter().map(|m| m.as_impact()).collect();
     cumulative_series(&impacts)
         .iter()
         .map(|p| (p.grain_mass_kg * G_PER_KG, p.mass_loss_kg * MG_PER_KG))

@@ -21,6 +21,29 @@ pub struct RawImpact {
     pub grain_mass_kg: f64,
     /// Surface mass removed by the impact, kg (per metre of depth in 2D).
     pub mass_loss_kg: f64,
+    /// What else the impact did; only the damage it added is read.
+    #[serde(default)]
+    pub outcome: Option<RawOutcome>,
+}
+
+/// The part of an impact's outcome the charts read.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct RawOutcome {
+    /// Damage the impact added to the surface, Σ m ΔD (seed eq. 19), kg (per metre of depth in
+    /// 2D); absent in records written before it was recorded.
+    #[serde(default)]
+    pub damage_added_kg: Option<f64>,
+}
+
+impl RawImpact {
+    /// The impact as the aggregate counts it: grain, loss and the damage added, if recorded.
+    pub fn as_impact(&self) -> grit_erosion::Impact {
+        grit_erosion::Impact {
+            grain_mass_kg: self.grain_mass_kg,
+            mass_loss_kg: self.mass_loss_kg,
+            damage_added_kg: self.outcome.and_then(|o| o.damage_added_kg),
+        }
+    }
 }
 
 /// One sample's per-impact series (`raw[]` of `grit run --raw` or `grit results --raw`).

@@ -1,8 +1,9 @@
 //! grit-plot: charts of campaign results as PNG and SVG, after the seed paper's section 4
 //! figures: mass loss against grain mass (Figs. 8, 10b), one sample at every angle
 //! (Fig. 9), erosion against impact angle with Oka's model (Figs. 11a, 12a), erosion
-//! normalised at 45° (Fig. 12b), the shape-modified Oka model (Fig. 14) and convergence
-//! with the number of samples (Fig. 10a).
+//! normalised at 45° (Fig. 12b), the shape-modified Oka model (Fig. 14), convergence
+//! with the number of samples (Fig. 10a), and each cell's loss against the damage its impacts
+//! added, window by window (eq. 19; the damage balance of docs/erosion.md).
 //!
 //! It reads the results JSON that `grit run` and `grit results` write (grit-erosion's
 //! `CampaignResults`, plus the optional `raw` per-impact series) and knows nothing of the
@@ -14,6 +15,7 @@
 #![warn(missing_docs)]
 
 mod analysis;
+mod balance;
 mod charts;
 mod draw;
 mod fit;
@@ -35,7 +37,7 @@ pub use fit::plot_fit;
 pub use fonts::register_fonts;
 pub use input::{
     load, load_any, load_jet_runs, merge, parse, parse_any, AnyInput, PlotInput, RawImpact,
-    RawSeries,
+    RawOutcome, RawSeries,
 };
 pub use jet::{jet_summary_table, plot_jet};
 pub use jet_picture::{jet_png, JetField, JetPicture};
@@ -96,6 +98,7 @@ pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
     charts::normalised(&analysis, out, &mut report)?;
     charts::modified_oka(&analysis, out, &mut report)?;
     charts::convergence(&input.results, out, &mut report)?;
+    balance::damage_balance(input, out, &mut report)?;
     report.notes.extend(analysis.steady_notes.iter().cloned());
     Ok(report)
 }

@@ -21,7 +21,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::aggregate::{SampleInput, SLOPE_WINDOW};
+use super::aggregate::{Impact, SampleInput, SLOPE_WINDOW};
 use crate::stats::stats;
 
 /// Impacts of the window over which loss and damage added are compared: the paper's last-20
@@ -105,10 +105,45 @@ impl DamageBalance {
 /// below two such samples or when any of their windows has an impact without its damage
 /// recorded (records written before it was).
 pub fn assess(samples: &[&SampleInput]) -> Option<DamageBalance> {
+    balance_of(
+        samples
+            .iter()
+            .filter(|s| s.impacts.len() >= BALANCE_POINTS)
+            .map(|s| &s.impacts[s.impacts.len() - BALANCE_POINTS..]),
+    )
+}
+
+/// The balance of one window of every sample, impacts `end − BALANCE_POINTS + 1 ..= end`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WindowBalance {
+    /// Last impact of the window (1-based).
+    pub end: usize,
+    /// Loss against damage added over that window, in the samples that reached it.
+    pub balance: DamageBalance,
+}
+
+/// How a cell approached its balance: the balance of each whole window, impacts 1–20, 21–40,
+/// …, over the samples that reached its end. Windows with fewer than two such samples, or an
+/// impact without its damage recorded, are left out.
+pub fn history(samples: &[&SampleInput]) -> Vec<WindowBalance> {
+    let longest = samples.iter().map(|s| s.impacts.len()).max().unwrap_or(0);
+    (1..=longest / BALANCE_POINTS)
+        .map(|k| k * BALANCE_POINTS)
+        .filter_map(|end| {
+            let windows = samples
+                .iter()
+                .filter(|s| s.impacts.len() >= end)
+                .map(|s| &s.impacts[end - BALANCE_POINTS..end]);
+            balance_of(windows).map(|balance| WindowBalance { end, balance })
+        })
+        .collect()
+}
+
+/// Paired loss against damage added per gram of grain over one window per sample.
+fn balance_of<'a>(windows: impl Iterator<Item = &'a [Impact]>) -> Option<DamageBalance> {
     let mut loss = Vec::new();
     let mut damage = Vec::new();
-    for s in samples.iter().filter(|s| s.impacts.len() >= BALANCE_POINTS) {
-        let window = &s.impacts[s.impacts.len() - BALANCE_POINTS..];
+    for window in windows {
         let grain: f64 = window.iter().map(|i| i.grain_mass_kg).sum();
         let added = window
             .iter()
@@ -140,7 +175,6 @@ pub fn assess(samples: &[&SampleInput]) -> Option<DamageBalance> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::impact::aggregate::Impact;
 
     /// `n` impacts of 1e-4 kg grains, each losing `loss` and adding `added` × the grain mass.
     fn sample(index: u32, n: usize, loss: f64, added: Option<f64>) -> SampleInput {
@@ -222,5 +256,39 @@ mod tests {
         s[1].impacts[10].damage_added_kg = Some(0.0);
         s[1].impacts[2].damage_added_kg = None;
         assert!(assess(&s.iter().collect::<Vec<_>>()).is_some());
+    }
+
+    #[test]
+    fn the_history_follows_each_whole_window_over_the_samples_that_reached_it() {
+        // Three samples; the loss steps up from 1 to 4 mg/g at impact 41 against 4 mg/g added.
+        let mut s: Vec<SampleInput> = (0..3).map(|k| sample(k, 60, 0.0, Some(4e-3))).collect();
+        for (k, x) in s.iter_mut().enumerate() {
+            for (i, imp) in x.impacts.iter_mut().enumerate() {
+                let base = if i < 40 { 1e-3 } else { 4e-3 };
+                imp.mass_loss_kg = (base + 1e-4 * k as f64) * imp.grain_mass_kg;
+            }
+        }
+        // A fourth sample stops at 45: it counts in the first two windows only.
+        s.push(sample(3, 45, 1e-3, Some(4e-3)));
+        let h = history(&s.iter().collect::<Vec<_>>());
+        assert_eq!(h.iter().map(|w| w.end).collect::<Vec<_>>(), [20, 40, 60]);
+        assert_eq!(
+            h.iter().map(|w| w.balance.samples).collect::<Vec<_>>(),
+            [4, 4, 3]
+        );
+        assert!(
+            (h[1].balance.ratio.unwrap() - 1.075 / 4.0).abs() < 1e-9,
+            "{h:?}"
+        );
+        assert!(!h[1].balance.balanced && h[2].balance.balanced, "{h:?}");
+        // The last window is the cell's own balance where every sample reached it.
+        assert_eq!(
+            h[2].balance,
+            assess(&s[..3].iter().collect::<Vec<_>>()).unwrap()
+        );
+        // An impact without damage drops its window only.
+        s[0].impacts[5].damage_added_kg = None;
+        let h = history(&s.iter().collect::<Vec<_>>());
+        assert_eq!(h.iter().map(|w| w.end).collect::<Vec<_>>(), [40, 60]);
     }
 }
