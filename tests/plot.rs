@@ -113,6 +113,35 @@ fn plot_writes_every_chart_for_the_quick_results() {
     assert!(stdout.contains("wrote 10 files:"), "{stdout}");
 }
 
+/// Impact `k`'s record: its grain, loss and damage added (kg/m), the grain's orientation and aim.
+fn record(
+    k: u32,
+    grain: f64,
+    loss: f64,
+    damage: Option<f64>,
+    orientation_rad: f64,
+    aim_x_m: f64,
+) -> ImpactRecord {
+    ImpactRecord {
+        impact: k,
+        grain_mass_kg: grain,
+        mass_loss_kg: loss,
+        orientation_rad,
+        aim_x_m,
+        outcome: ImpactOutcome {
+            mass_loss_kg: loss,
+            removed_particles: 0,
+            detached_kg: 0.0,
+            detached_particles: 0,
+            sim_time_s: 1e-6,
+            steps: 1000,
+            rebound_ratio: 0.5,
+            settled: true,
+            damage_added_kg: damage,
+        },
+    }
+}
+
 /// A results file with raw series: three shapes at six angles, 3 samples of 30 impacts,
 /// eroding at the seed's modified-Oka rates with noise after 5 impacts of incubation.
 fn synthetic_results() -> serde_json::Value {
@@ -136,24 +165,7 @@ fn synthetic_results() -> serde_json::Value {
                         let grain = 1.2e-4 * (1.0 + 0.05 * noise());
                         let rate = model.erosion(angle, e, an) * (1.0 + 0.5 * noise());
                         let loss = if k > 5 { grain * rate } else { 0.0 };
-                        ImpactRecord {
-                            impact: k,
-                            grain_mass_kg: grain,
-                            mass_loss_kg: loss,
-                            orientation_rad: noise(),
-                            aim_x_m: 1e-5 * noise(),
-                            outcome: ImpactOutcome {
-                                mass_loss_kg: loss,
-                                removed_particles: 0,
-                                detached_kg: 0.0,
-                                detached_particles: 0,
-                                sim_time_s: 1e-6,
-                                steps: 1000,
-                                rebound_ratio: 0.5,
-                                settled: true,
-                                damage_added_kg: None,
-                            },
-                        }
+                        record(k, grain, loss, None, noise(), 1e-5 * noise())
                     })
                     .collect();
                 samples.push(SampleInput {
@@ -323,24 +335,7 @@ fn balance_results() -> (serde_json::Value, Vec<Vec<SampleInput>>) {
                     let grain = 1.2e-4;
                     let rate = 4e-3 * (k as f64 / 60.0).min(1.0) * (1.0 + 0.2 * noise());
                     let damage = 4e-3 * grain * (1.0 + 0.05 * noise());
-                    ImpactRecord {
-                        impact: k,
-                        grain_mass_kg: grain,
-                        mass_loss_kg: grain * rate,
-                        orientation_rad: 0.0,
-                        aim_x_m: 0.0,
-                        outcome: ImpactOutcome {
-                            mass_loss_kg: grain * rate,
-                            removed_particles: 0,
-                            detached_kg: 0.0,
-                            detached_particles: 0,
-                            sim_time_s: 1e-6,
-                            steps: 1000,
-                            rebound_ratio: 0.5,
-                            settled: true,
-                            damage_added_kg: Some(damage),
-                        },
-                    }
+                    record(k, grain, grain * rate, Some(damage), 0.0, 0.0)
                 })
                 .collect();
             samples.push(SampleInput {

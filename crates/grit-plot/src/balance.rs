@@ -10,10 +10,10 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::analysis::series_label;
-use crate::charts::legend_box;
+use crate::charts::{cell_stem, legend_box};
 use crate::draw::{
-    chart_on, colour, de, draw_mesh, error_bar, file_safe, line_key, marker_style, save, top,
-    with_notes, DrawResult, Figure,
+    chart_on, colour, de, draw_mesh, error_bar, line_key, marker_style, save, top, with_notes,
+    Axes, DrawResult, Figure,
 };
 use crate::{PlotError, PlotInput, Report};
 
@@ -78,18 +78,14 @@ impl Figure for BalanceChart<'_> {
                     .map_err(de)?;
             }
         }
-        let line = damage_col.stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(w.iter().map(damage), line))
-            .map_err(de)?
-            .label("damage added, Σ m ΔD per g of grains (±1 s.e.)")
-            .legend(line_key(line));
-        chart
-            .draw_series(
-                w.iter()
-                    .map(|x| Circle::new(damage(x), 3, damage_col.filled())),
-            )
-            .map_err(de)?;
+        let points = |f: &dyn Fn(&WindowBalance) -> (f64, f64)| w.iter().map(f).collect::<Vec<_>>();
+        line_with_marks(
+            &mut chart,
+            points(&damage),
+            damage_col,
+            "damage added, Σ m ΔD per g of grains (±1 s.e.)",
+            |_| (3, damage_col.filled()),
+        )?;
         let dashed = damage_col.mix(0.7).stroke_width(1);
         chart
             .draw_series(std::iter::once(DashedPathElement::new(
@@ -103,21 +99,39 @@ impl Figure for BalanceChart<'_> {
                 "{BALANCE_MIN_RATIO} × damage added: the balance's floor"
             ))
             .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], 4, 3, dashed));
-        let line = loss_col.stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(w.iter().map(loss), line))
-            .map_err(de)?
-            .label("mass loss per g of grains (±1 s.e.); filled: balanced window")
-            .legend(line_key(line));
-        chart
-            .draw_series(
-                w.iter().map(|x| {
-                    Circle::new(loss(x), 4, marker_style(loss_col, Some(x.balance.balanced)))
-                }),
-            )
-            .map_err(de)?;
+        line_with_marks(
+            &mut chart,
+            points(&loss),
+            loss_col,
+            "mass loss per g of grains (±1 s.e.); filled: balanced window",
+            |k| (4, marker_style(loss_col, Some(w[k].balance.balanced))),
+        )?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
+}
+
+/// A labelled line through `pts` with a circle at each, of the radius and style `mark(k)` gives
+/// point `k`.
+fn line_with_marks<DB: DrawingBackend>(
+    chart: &mut Axes<'_, DB>,
+    pts: Vec<(f64, f64)>,
+    col: RGBColor,
+    label: &str,
+    mark: impl Fn(usize) -> (i32, ShapeStyle),
+) -> DrawResult {
+    let line = col.stroke_width(2);
+    chart
+        .draw_series(LineSeries::new(pts.iter().copied(), line))
+        .map_err(de)?
+        .label(label)
+        .legend(line_key(line));
+    chart
+        .draw_series(pts.iter().enumerate().map(|(k, p)| {
+            let (r, style) = mark(k);
+            Circle::new(*p, r, style)
+        }))
+        .map_err(de)?;
+    Ok(())
 }
 
 /// One chart per cell whose raw series carry the damage each impact added: loss and damage
@@ -184,12 +198,9 @@ pub fn damage_balance(
             windows,
             notes,
         };
-        let stem = format!(
-            "damage_balance_c{i:02}_{}deg_{}",
-            c.angle_deg,
-            file_safe(&series_label(&c.shape, &c.swept))
-        );
-        report.files.extend(save(&fig, out, &stem)?);
+        report
+            .files
+            .extend(save(&fig, out, &cell_stem("damage_balance", i, c))?);
     }
     Ok(())
 }

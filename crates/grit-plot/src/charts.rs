@@ -30,6 +30,15 @@ fn curve_angles() -> impl Iterator<Item = f64> {
     (1..=180).map(|k| 0.5 * k as f64)
 }
 
+/// File stem of cell `i`'s chart of `kind`: `kind_cNN_<angle>deg_<shape and swept values>`.
+pub(crate) fn cell_stem(kind: &str, i: usize, c: &CellResult) -> String {
+    format!(
+        "{kind}_c{i:02}_{}deg_{}",
+        c.angle_deg,
+        file_safe(&series_label(&c.shape, &c.swept))
+    )
+}
+
 fn cell_label(c: &CellResult) -> String {
     format!("{}°, {}", c.angle_deg, series_label(&c.shape, &c.swept))
 }
@@ -321,12 +330,9 @@ pub fn mass_loss(
             window: results.slope_window,
             notes,
         };
-        let stem = format!(
-            "mass_loss_c{i:02}_{}deg_{}",
-            c.angle_deg,
-            file_safe(&series_label(&c.shape, &c.swept))
-        );
-        report.files.extend(save(&fig, out, &stem)?);
+        report
+            .files
+            .extend(save(&fig, out, &cell_stem("mass_loss", i, c))?);
     }
     Ok(())
 }
