@@ -82,6 +82,19 @@ async fn two_workers_complete_a_campaign_and_match_grit_run() {
     assert_eq!(farm["partial"], Value::Bool(false));
     let local = grit_run(dir.path(), &spec, "local", false);
     assert_eq!(farm, local, "farm results equal grit run results");
+    // Without --raw, results.json leaves the series out, but the charts are drawn from them:
+    // the per-sample damage balance needs every impact.
+    assert!(local.get("raw").is_none(), "{local}");
+    let charts: Vec<String> = std::fs::read_dir(dir.path().join("local"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    assert!(
+        charts
+            .iter()
+            .any(|n| n.starts_with("damage_balance_c00_") && n.ends_with(".png")),
+        "{charts:?}"
+    );
     // The same spec again resumes (here: finds it done); another spec in the same folder is
     // refused before it could overwrite the first one's results and charts.
     assert_eq!(grit_run(dir.path(), &spec, "local", false), local);

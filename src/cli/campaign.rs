@@ -294,17 +294,27 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     })
     .await?;
     bar.finish();
-    write_json(&results_path, &outcome.results)?;
+    let mut written = outcome.results.clone();
+    if !a.raw {
+        written.strip_raw();
+    }
+    write_json(&results_path, &written)?;
     eprintln!(
         "campaign {:?}; results in {}",
         outcome.state,
         results_path.display()
     );
-    say_cells(&outcome.results);
-    warn_unsteady_any(&outcome.results, true);
-    // Charts beside results.json (`grit plot` draws the same); a chart that fails leaves
-    // the results, already written, standing.
-    match grit_plot::plot_file(&results_path, &out) {
+    say_cells(&written);
+    warn_unsteady_any(&written, true);
+    // Charts beside results.json, from every sample's series even where results.json leaves
+    // them out: the per-sample curves and the damage balance need them (`grit plot` on a
+    // `--raw` file draws the same). A chart that fails leaves the results, already written,
+    // standing.
+    let charts = serde_json::to_string(&outcome.results)
+        .map_err(|e| grit_plot::PlotError::Input(e.to_string()))
+        .and_then(|text| grit_plot::parse_any(&text))
+        .and_then(|input| grit_plot::plot_any(&input, &out));
+    match charts {
         Ok(r) => eprintln!(
             "{} chart files (PNG, SVG) in {}",
             r.files.len(),

@@ -75,7 +75,9 @@ pub enum RunEvent<'a> {
 pub struct EmbeddedOutcome {
     /// Final state of the campaign (not final when stopped from outside).
     pub state: CampaignState,
-    /// The results, as the results endpoint serves them.
+    /// The results, as the results endpoint serves them with `?raw=true` whatever
+    /// [`EmbeddedOptions::raw`] says: the charts need every sample's series, and the caller
+    /// drops them before writing where they were not asked for ([`AnyResults::strip_raw`]).
     pub results: AnyResults,
 }
 
@@ -332,7 +334,7 @@ pub async fn run(
             Err(e) => on_event(RunEvent::Note(format!("worker panicked: {e}"))),
         }
     }
-    let results = store.results_any(created.id, opts.raw).await?;
+    let results = store.results_any(created.id, true).await?;
     running.stop().await;
     Ok(EmbeddedOutcome { state, results })
 }

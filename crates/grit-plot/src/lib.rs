@@ -105,9 +105,14 @@ pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
 
 /// Reads a results JSON file of either scene and writes its charts into `out`.
 pub fn plot_file(results: &Path, out: &Path) -> Result<Report, PlotError> {
-    match load_any(results)? {
-        AnyInput::Impact(input) => plot(&input, out),
-        AnyInput::Jet(r) => plot_jet(&r, out),
+    plot_any(&load_any(results)?, out)
+}
+
+/// Writes the charts of results of either scene into `out`.
+pub fn plot_any(input: &AnyInput, out: &Path) -> Result<Report, PlotError> {
+    match input {
+        AnyInput::Impact(input) => plot(input, out),
+        AnyInput::Jet(r) => plot_jet(r, out),
     }
 }
 

@@ -64,6 +64,15 @@ impl AnyResults {
         }
     }
 
+    /// Drops every sample's per-impact series or slices (`?raw=true`'s part), leaving what the
+    /// results endpoint serves without it.
+    pub fn strip_raw(&mut self) {
+        match self {
+            AnyResults::Jet(r) => r.raw = None,
+            AnyResults::Impact(r) => r.raw = None,
+        }
+    }
+
     /// Whether some cell still lacks samples, impacts or slices.
     pub fn partial(&self) -> bool {
         match self {
