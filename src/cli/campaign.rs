@@ -294,7 +294,9 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     })
     .await?;
     bar.finish();
-    let mut written = outcome.results.clone();
+    // Taken before the series are dropped: the charts below need them.
+    let charted = serde_json::to_string(&outcome.results);
+    let mut written = outcome.results;
     if !a.raw {
         written.strip_raw();
     }
@@ -310,7 +312,7 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     // them out: the per-sample curves and the damage balance need them (`grit plot` on a
     // `--raw` file draws the same). A chart that fails leaves the results, already written,
     // standing.
-    let charts = serde_json::to_string(&outcome.results)
+    let charts = charted
         .map_err(|e| grit_plot::PlotError::Input(e.to_string()))
         .and_then(|text| grit_plot::parse_any(&text))
         .and_then(|input| grit_plot::plot_any(&input, &out));

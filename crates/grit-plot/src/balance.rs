@@ -3,7 +3,7 @@
 //! 0.9 floor under which a window is not stationary.
 
 use grit_erosion::impact::aggregate::SampleInput;
-use grit_erosion::impact::balance::{history, WindowBalance, BALANCE_MIN_RATIO};
+use grit_erosion::impact::balance::{history, DamageBalance, WindowBalance, BALANCE_MIN_RATIO};
 use grit_erosion::CellResult;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
@@ -55,11 +55,15 @@ impl Figure for BalanceChart<'_> {
         )?;
         let cap = 0.15 * points;
         let (loss_col, damage_col) = (colour(0), colour(1));
-        let rate =
-            |f: fn(&WindowBalance) -> f64| move |x: &WindowBalance| (x.end as f64, f(x) * MG_PER_G);
-        let damage = rate(|x| x.balance.damage_rate);
-        let loss = rate(|x| x.balance.loss_rate);
-        let floor = rate(|x| BALANCE_MIN_RATIO * x.balance.damage_rate);
+        // (window end, mg/g) per window, of one rate of its balance.
+        let series = |f: fn(&DamageBalance) -> f64| -> Vec<(f64, f64)> {
+            w.iter()
+                .map(|x| (x.end as f64, f(&x.balance) * MG_PER_G))
+                .collect()
+        };
+        let damage = series(|b| b.damage_rate);
+        let loss = series(|b| b.loss_rate);
+        let floor = series(|b| BALANCE_MIN_RATIO * b.damage_rate);
         for x in w {
             let b = &x.balance;
             let e = x.end as f64;
@@ -78,22 +82,16 @@ impl Figure for BalanceChart<'_> {
                     .map_err(de)?;
             }
         }
-        let points = |f: &dyn Fn(&WindowBalance) -> (f64, f64)| w.iter().map(f).collect::<Vec<_>>();
         line_with_marks(
             &mut chart,
-            points(&damage),
+            damage,
             damage_col,
             "damage added, Σ m ΔD per g of grains (±1 s.e.)",
             |_| (3, damage_col.filled()),
         )?;
         let dashed = damage_col.mix(0.7).stroke_width(1);
         chart
-            .draw_series(std::iter::once(DashedPathElement::new(
-                w.iter().map(floor),
-                6,
-                4,
-                dashed,
-            )))
+            .draw_series(std::iter::once(DashedPathElement::new(floor, 6, 4, dashed)))
             .map_err(de)?
             .label(format!(
                 "{BALANCE_MIN_RATIO} × damage added: the balance's floor"
@@ -101,7 +99,7 @@ impl Figure for BalanceChart<'_> {
             .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], 4, 3, dashed));
         line_with_marks(
             &mut chart,
-            points(&loss),
+            loss,
             loss_col,
             "mass loss per g of grains (±1 s.e.); filled: balanced window",
             |k| (4, marker_style(loss_col, Some(w[k].balance.balanced))),
@@ -152,13 +150,9 @@ pub fn damage_balance(
         let samples: Vec<SampleInput> = raw
             .iter()
             .filter(|r| r.cell as usize == i)
-            .map(|r| {
-                let mut impacts = r.impacts.clone();
-                impacts.sort_by_key(|m| m.impact);
-                SampleInput {
-                    sample: r.sample,
-                    impacts: impacts.iter().map(|m| m.as_impact()).collect(),
-                }
+            .map(|r| SampleInput {
+                sample: r.sample,
+                impacts: r.impacts_in_order(),
             })
             .collect();
         let windows = history(&samples.iter().collect::<Vec<_>>());

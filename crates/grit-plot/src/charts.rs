@@ -6,7 +6,7 @@
 use std::ops::Range;
 
 use grit_erosion::impact::aggregate::cumulative_series;
-use grit_erosion::{CampaignResults, CellResult, Impact};
+use grit_erosion::{CampaignResults, CellResult};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -131,10 +131,7 @@ fn any_unsteady(mut steady: impl Iterator<Item = Option<bool>>) -> bool {
 
 /// A sample's cumulative (grain g/m, loss mg/m), in impact order.
 fn sample_curve(r: &RawSeries) -> Vec<(f64, f64)> {
-    let mut impacts = r.impacts.clone();
-    impacts.sort_by_key(|m| m.impact);
-    let impacts: Vec<Impact> = impacts.iter().map(|m| m.as_impact()).collect();
-    cumulative_series(&impacts)
+    cumulative_series(&r.impacts_in_order())
         .iter()
         .map(|p| (p.grain_mass_kg * G_PER_KG, p.mass_loss_kg * MG_PER_KG))
         .collect()

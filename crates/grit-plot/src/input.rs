@@ -57,6 +57,15 @@ pub struct RawSeries {
     pub impacts: Vec<RawImpact>,
 }
 
+impl RawSeries {
+    /// The sample's impacts in the order they hit the surface, as the aggregate counts them.
+    pub fn impacts_in_order(&self) -> Vec<grit_erosion::Impact> {
+        let mut impacts = self.impacts.clone();
+        impacts.sort_by_key(|m| m.impact);
+        impacts.iter().map(RawImpact::as_impact).collect()
+    }
+}
+
 /// A results file ready to plot.
 #[derive(Debug, Clone)]
 pub struct PlotInput {
