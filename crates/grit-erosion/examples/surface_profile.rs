@@ -10,8 +10,13 @@
 //! (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
-//! trench's local incidence strays from the nominal angle (notebook/erosion/trench-2026-11-28).
-//! Usage: `surface_profile [--columns | --incidence] CHECKPOINT…`.
+//! trench's local incidence strays from the nominal angle. `--grains FILE` does the same for
+//! the grains a campaign fired, read from FILE's rows (checkpoint, unit, orientation_rad,
+//! aim_x_m, tab-separated, with a header), each on its checkpoint's surface
+//! (notebook/erosion/trench-2026-11-28).
+//! Usage: `surface_profile [--columns | --incidence] CHECKPOINT…` or
+//! `surface_profile --grains FILE`.
+use grit_erosion::impact::{GrainStart, ImpactParams};
 use grit_erosion::Sample;
 use grit_sph::particles::KINEMATIC;
 use grit_sph::Vector;
@@ -27,21 +32,57 @@ enum Mode {
     Summary,
     Columns,
     Incidence,
+    Grains,
+}
+
+/// A fired grain to place on a checkpoint's surface: its impact number, orientation, aim.
+struct Fired {
+    unit: u32,
+    orientation_rad: f64,
+    aim_x_m: f64,
+}
+
+fn usage() -> ! {
+    eprintln!("usage: surface_profile [--columns | --incidence] CHECKPOINT… | --grains FILE");
+    std::process::exit(2);
 }
 
 fn main() {
-    let mut paths: Vec<String> = std::env::args().skip(1).collect();
-    let mode = match paths.first().map(String::as_str) {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let mode = match args.first().map(String::as_str) {
         Some("--columns") => Mode::Columns,
         Some("--incidence") => Mode::Incidence,
+        Some("--grains") => Mode::Grains,
         _ => Mode::Summary,
     };
     if mode != Mode::Summary {
-        paths.remove(0);
+        args.remove(0);
     }
-    if paths.is_empty() {
-        eprintln!("usage: surface_profile [--columns | --incidence] CHECKPOINT…");
-        std::process::exit(2);
+    // Checkpoints in order, each with the fired grains to place on it (`--grains` only).
+    let mut work: Vec<(String, Vec<Fired>)> = Vec::new();
+    if mode == Mode::Grains {
+        let [file] = args.as_slice() else { usage() };
+        let text = std::fs::read_to_string(file).expect("read grains file");
+        for line in text.lines().skip(1) {
+            let f: Vec<&str> = line.split('\t').collect();
+            let [path, unit, orientation, aim] = f.as_slice() else {
+                panic!("grains row needs 4 tab-separated fields: {line}")
+            };
+            let fired = Fired {
+                unit: unit.parse().expect("unit"),
+                orientation_rad: orientation.parse().expect("orientation_rad"),
+                aim_x_m: aim.parse().expect("aim_x_m"),
+            };
+            match work.last_mut() {
+                Some((p, v)) if p == path => v.push(fired),
+                _ => work.push((path.to_string(), vec![fired])),
+            }
+        }
+    } else {
+        work = args.into_iter().map(|p| (p, Vec::new())).collect();
+    }
+    if work.is_empty() {
+        usage();
     }
     println!(
         "{}",
@@ -51,9 +92,11 @@ fn main() {
             Mode::Columns => "checkpoint\timpacts\tangle_deg\tx_dg\ttop_dg",
             Mode::Incidence =>
                 "checkpoint\timpacts\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg",
+            Mode::Grains =>
+                "checkpoint\tunit\timpacts\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg",
         }
     );
-    for path in &paths {
+    for (path, fired) in &work {
         let bytes = std::fs::read(path).expect("read checkpoint");
         let s = Sample::from_checkpoint(&bytes).expect("checkpoint");
         let p = s.params();
@@ -76,12 +119,12 @@ fn main() {
             .filter(|(_, t)| t.is_finite())
             .map(|(c, t)| Vector::new(centre(c), *t))
             .collect();
+        let done = s.impacts_done();
         match mode {
             Mode::Columns => {
                 for t in &tops {
                     println!(
-                        "{path}\t{}\t{}\t{:.4}\t{:.4}",
-                        s.impacts_done(),
+                        "{path}\t{done}\t{}\t{:.4}\t{:.4}",
                         p.angle_deg,
                         t.x / dg,
                         t.y / dg
@@ -94,22 +137,19 @@ fn main() {
                         let u_angle = (i as f64 + 0.5) / ORIENTATIONS as f64;
                         let u_aim = (j as f64 + 0.5) / AIMS as f64;
                         let g = p.grain_start(u_angle, u_aim).expect("grain");
-                        let dir = g.velocity_m_s.normalize();
-                        let Some(hit) = first_touch(g.polygon.vertices(), dir, &tops) else {
-                            continue;
-                        };
-                        let slope = local_slope(&tops, hit.x, SLOPE_HALF_WIDTH_DG * dg);
-                        let tangent = Vector::new(1.0, slope).normalize();
-                        let local = (dir.x * tangent.y - dir.y * tangent.x).abs().asin();
-                        println!(
-                            "{path}\t{}\t{}\t{:.4}\t{:.4}\t{:.4}\t{:.2}",
-                            s.impacts_done(),
-                            p.angle_deg,
-                            g.aim_x_m / dg,
-                            hit.x / dg,
-                            hit.y / dg,
-                            local.to_degrees()
-                        );
+                        if let Some(row) = touch(p, &tops, &g) {
+                            println!("{path}\t{done}\t{}\t{row}", p.angle_deg);
+                        }
+                    }
+                }
+            }
+            Mode::Grains => {
+                for f in fired {
+                    let u_angle = f.orientation_rad / std::f64::consts::TAU;
+                    let u_aim = f.aim_x_m / (p.distribution_range_dg * dg) + 0.5;
+                    let g = p.grain_start(u_angle, u_aim).expect("grain");
+                    if let Some(row) = touch(p, &tops, &g) {
+                        println!("{path}\t{}\t{done}\t{}\t{row}", f.unit, p.angle_deg);
                     }
                 }
             }
@@ -125,8 +165,7 @@ fn main() {
                 let floor = band.iter().copied().fold(f64::INFINITY, f64::min);
                 let mean = band.iter().sum::<f64>() / band.len() as f64;
                 println!(
-                    "{path}\t{}\t{:.3}\t{:.3}\t{:.3}\t{:.3}",
-                    s.impacts_done(),
+                    "{path}\t{done}\t{:.3}\t{:.3}\t{:.3}\t{:.3}",
                     lips / dg,
                     floor / dg,
                     -mean / dg,
@@ -135,6 +174,24 @@ fn main() {
             }
         }
     }
+}
+
+/// Where grain `g` first touches the column tops and the angle its path makes with the
+/// surface's slope there, as the tab-separated aim, touch x and y (Dg) and angle (degrees).
+fn touch(p: &ImpactParams, tops: &[Vector], g: &GrainStart) -> Option<String> {
+    let dg = p.grain_diameter_m;
+    let dir = g.velocity_m_s.normalize();
+    let hit = first_touch(g.polygon.vertices(), dir, tops)?;
+    let slope = local_slope(tops, hit.x, SLOPE_HALF_WIDTH_DG * dg);
+    let tangent = Vector::new(1.0, slope).normalize();
+    let local = (dir.x * tangent.y - dir.y * tangent.x).abs().asin();
+    Some(format!(
+        "{:.4}\t{:.4}\t{:.4}\t{:.2}",
+        g.aim_x_m / dg,
+        hit.x / dg,
+        hit.y / dg,
+        local.to_degrees()
+    ))
 }
 
 /// The surface point the polygon, moving along `dir`, reaches first: each point cast back
