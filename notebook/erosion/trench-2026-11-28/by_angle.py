@@ -106,6 +106,8 @@ def clustered(b, key):
     by = {}
     for i in v:
         by[i['s']] = by.get(i['s'], 0.0) + i[key] - m
+    if len(by) < 2:
+        return f'{m:.2f} (one sample)'
     return f'{m:.2f} ± {math.sqrt(sum(x * x for x in by.values())) / len(v):.2f}'
 
 
