@@ -14,10 +14,15 @@
 //! the grains a campaign fired, read from FILE's rows (checkpoint, unit, orientation_rad,
 //! aim_x_m, tab-separated, with a header), each on its checkpoint's surface
 //! (notebook/erosion/trench-2026-11-28).
-//! Usage: `surface_profile [--columns | --incidence] CHECKPOINT…` or
-//! `surface_profile --grains FILE`.
+//! `--run ANGLE SPACING_M SAMPLES IMPACTS SEED OUT` runs fresh samples of the ladder's scene
+//! (the seed's, on a 3.0 × 1.25 Dg surface with a 1.0 Dg aim band, one thread) and writes, for
+//! every impact, where its grain first touched the surface just before it and at what local
+//! angle, with its damage added and loss (OUT-impacts.tsv), and every 20 impacts each sample's
+//! column tops (OUT-columns.tsv).
+//! Usage: `surface_profile [--columns | --incidence] CHECKPOINT…`,
+//! `surface_profile --grains FILE` or `surface_profile --run …`.
 use grit_erosion::impact::{GrainStart, ImpactParams};
-use grit_erosion::Sample;
+use grit_erosion::{Sample, Shape};
 use grit_sph::particles::KINEMATIC;
 use grit_sph::Vector;
 
@@ -53,6 +58,7 @@ fn main() {
         Some("--columns") => Mode::Columns,
         Some("--incidence") => Mode::Incidence,
         Some("--grains") => Mode::Grains,
+        Some("--run") => return run(&args[1..]),
         _ => Mode::Summary,
     };
     if mode != Mode::Summary {
@@ -100,25 +106,8 @@ fn main() {
         let bytes = std::fs::read(path).expect("read checkpoint");
         let s = Sample::from_checkpoint(&bytes).expect("checkpoint");
         let p = s.params();
-        let (dg, dx) = (p.grain_diameter_m, p.spacing_m);
-        let half = 0.5 * p.surface_width_dg * dg;
-        let columns = (2.0 * half / dx).ceil() as usize;
-        let mut top = vec![f64::NEG_INFINITY; columns];
-        let surface = s.surface();
-        for (x, flags) in surface.pos.iter().zip(&surface.flags) {
-            if flags & KINEMATIC != 0 {
-                continue;
-            }
-            let c = (((x.x + half) / dx).floor().max(0.0) as usize).min(columns - 1);
-            top[c] = top[c].max(x.y);
-        }
-        let centre = |c: usize| (c as f64 + 0.5) * dx - half;
-        let tops: Vec<Vector> = top
-            .iter()
-            .enumerate()
-            .filter(|(_, t)| t.is_finite())
-            .map(|(c, t)| Vector::new(centre(c), *t))
-            .collect();
+        let dg = p.grain_diameter_m;
+        let (top, tops) = column_tops(&s);
         let done = s.impacts_done();
         match mode {
             Mode::Columns => {
@@ -173,6 +162,86 @@ fn main() {
                 );
             }
         }
+    }
+}
+
+/// The free surface's highest point per column one Δx wide (−∞ where a column is empty), and
+/// the non-empty columns as (centre, top) points.
+fn column_tops(s: &Sample) -> (Vec<f64>, Vec<Vector>) {
+    let p = s.params();
+    let dx = p.spacing_m;
+    let half = 0.5 * p.surface_width_dg * p.grain_diameter_m;
+    let columns = (2.0 * half / dx).ceil() as usize;
+    let mut top = vec![f64::NEG_INFINITY; columns];
+    let surface = s.surface();
+    for (x, flags) in surface.pos.iter().zip(&surface.flags) {
+        if flags & KINEMATIC != 0 {
+            continue;
+        }
+        let c = (((x.x + half) / dx).floor().max(0.0) as usize).min(columns - 1);
+        top[c] = top[c].max(x.y);
+    }
+    let tops = top
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.is_finite())
+        .map(|(c, t)| Vector::new((c as f64 + 0.5) * dx - half, *t))
+        .collect();
+    (top, tops)
+}
+
+/// `--run`: fresh samples, each impact's touch and local angle on the surface just before it.
+fn run(args: &[String]) {
+    let [angle, spacing, samples, impacts, seed, out] = args else {
+        eprintln!("usage: surface_profile --run ANGLE SPACING_M SAMPLES IMPACTS SEED OUT");
+        std::process::exit(2);
+    };
+    let num = |v: &str, what: &str| -> f64 {
+        v.parse()
+            .unwrap_or_else(|_| panic!("{what} must be a number, got {v}"))
+    };
+    let mut params = ImpactParams::paper(num(angle, "ANGLE"), Shape::Hexagon);
+    params.spacing_m = num(spacing, "SPACING_M");
+    params.distribution_range_dg = 1.0;
+    params.surface_width_dg = 3.0;
+    params.surface_depth_dg = 1.25;
+    let (samples, impacts) = (
+        num(samples, "SAMPLES") as u64,
+        num(impacts, "IMPACTS") as u32,
+    );
+    let seed = num(seed, "SEED") as u64;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let mut rows = String::from("sample\timpact\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg\tdamage_mg_g\tloss_mg_g\n");
+    let mut cols = String::from("sample\timpacts\tangle_deg\tx_dg\ttop_dg\n");
+    let dg = params.grain_diameter_m;
+    for k in 0..samples {
+        let mut s = Sample::new(params.clone(), seed + k).expect("sample");
+        for n in 0..impacts {
+            let (_, tops) = column_tops(&s);
+            if n % 20 == 0 {
+                for t in &tops {
+                    cols += &format!("{k}\t{n}\t{angle}\t{:.4}\t{:.4}\n", t.x / dg, t.y / dg);
+                }
+            }
+            let grain = s.next_grain().expect("grain");
+            let touched = touch(s.params(), &tops, &grain);
+            let record = pool.install(|| s.run_next()).expect("impact").clone();
+            let per_g = 1e3 / record.grain_mass_kg;
+            if let Some(t) = touched {
+                rows += &format!(
+                    "{k}\t{}\t{angle}\t{t}\t{:.5}\t{:.5}\n",
+                    record.impact,
+                    record.outcome.damage_added_kg.unwrap_or(f64::NAN) * per_g,
+                    record.mass_loss_kg * per_g
+                );
+            }
+        }
+        eprintln!("sample {k}: {impacts} impacts");
+        std::fs::write(format!("{out}-impacts.tsv"), &rows).expect("write impacts");
+        std::fs::write(format!("{out}-columns.tsv"), &cols).expect("write columns");
     }
 }
 
