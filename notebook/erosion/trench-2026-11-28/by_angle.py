@@ -17,8 +17,8 @@ per bin of local angle; standard errors clustered by sample.
 Usage: python3 by_angle.py campaign SURFACE_PROFILE KEPT RUN CELL DB OUT
          e.g. campaign target/release/examples/surface_profile /work/runs/ckpt-keep paper 2 \\
               /work/runs/paper/grit.db /tmp/trench/paper45
-       python3 by_angle.py run PREFIX   (PREFIX-impacts.tsv and PREFIX-columns.tsv)"""
-import csv, math, os, re, sqlite3, statistics as st, subprocess, sys
+       python3 by_angle.py run PREFIX   (PREFIX-impacts.tsv and PREFIX-columns.tsv, or their .xz)"""
+import csv, lzma, math, os, re, sqlite3, statistics as st, subprocess, sys
 
 WINDOW, MIN_SAMPLES, HALF_WIDTH_DG = 20, 5, 0.1
 
@@ -75,16 +75,21 @@ def from_campaign(exe, kept, run, cell, db, out):
     return f'{run}, cell {cell}', impacts, profiles(csv.DictReader(columns.splitlines(), delimiter='\t'))
 
 
+def text(path):
+    """A table file, or its committed .xz copy."""
+    return open(path) if os.path.exists(path) else lzma.open(path + '.xz', 'rt')
+
+
 def from_run(prefix):
     impacts = []
-    for r in csv.DictReader(open(prefix + '-impacts.tsv'), delimiter='\t'):
+    for r in csv.DictReader(text(prefix + '-impacts.tsv'), delimiter='\t'):
         n = int(r['impact'])
         impacts.append(dict(s=int(r['sample']), k=(n - 1) // WINDOW * WINDOW,
                             nominal=float(r['angle_deg']), x=float(r['contact_x_dg']),
                             own=float(r['local_deg']), damage=float(r['damage_mg_g']),
                             loss=float(r['loss_mg_g'])))
     return os.path.basename(prefix), impacts, profiles(
-        csv.DictReader(open(prefix + '-columns.tsv'), delimiter='\t'))
+        csv.DictReader(text(prefix + '-columns.tsv'), delimiter='\t'))
 
 
 def profiles(rows):
