@@ -48,7 +48,9 @@ struct Fired {
 }
 
 fn usage() -> ! {
-    eprintln!("usage: surface_profile [--columns | --incidence] CHECKPOINT… | --grains FILE");
+    eprintln!(
+        "usage: surface_profile [--columns | --incidence] CHECKPOINT… | --grains FILE | --run …"
+    );
     std::process::exit(2);
 }
 
@@ -107,7 +109,7 @@ fn main() {
         let s = Sample::from_checkpoint(&bytes).expect("checkpoint");
         let p = s.params();
         let dg = p.grain_diameter_m;
-        let (top, tops) = column_tops(&s);
+        let tops = column_tops(&s);
         let done = s.impacts_done();
         match mode {
             Mode::Columns => {
@@ -143,7 +145,7 @@ fn main() {
                 }
             }
             Mode::Summary => {
-                let lips = top.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let lips = tops.iter().map(|t| t.y).fold(f64::NEG_INFINITY, f64::max);
                 // The aim band's columns: centres within half the distribution range of the middle.
                 let reach = 0.5 * p.distribution_range_dg * dg;
                 let band: Vec<f64> = tops
@@ -165,9 +167,9 @@ fn main() {
     }
 }
 
-/// The free surface's highest point per column one Δx wide (−∞ where a column is empty), and
-/// the non-empty columns as (centre, top) points.
-fn column_tops(s: &Sample) -> (Vec<f64>, Vec<Vector>) {
+/// The free surface's highest point per column one Δx wide, as (column centre, top) points;
+/// empty columns are left out.
+fn column_tops(s: &Sample) -> Vec<Vector> {
     let p = s.params();
     let dx = p.spacing_m;
     let half = 0.5 * p.surface_width_dg * p.grain_diameter_m;
@@ -181,13 +183,11 @@ fn column_tops(s: &Sample) -> (Vec<f64>, Vec<Vector>) {
         let c = (((x.x + half) / dx).floor().max(0.0) as usize).min(columns - 1);
         top[c] = top[c].max(x.y);
     }
-    let tops = top
-        .iter()
+    top.iter()
         .enumerate()
         .filter(|(_, t)| t.is_finite())
         .map(|(c, t)| Vector::new((c as f64 + 0.5) * dx - half, *t))
-        .collect();
-    (top, tops)
+        .collect()
 }
 
 /// `--run`: fresh samples, each impact's touch and local angle on the surface just before it.
@@ -220,7 +220,7 @@ fn run(args: &[String]) {
     for k in 0..samples {
         let mut s = Sample::new(params.clone(), seed + k).expect("sample");
         for n in 0..impacts {
-            let (_, tops) = column_tops(&s);
+            let tops = column_tops(&s);
             if n % 20 == 0 {
                 for t in &tops {
                     cols += &format!("{k}\t{n}\t{angle}\t{:.4}\t{:.4}\n", t.x / dg, t.y / dg);

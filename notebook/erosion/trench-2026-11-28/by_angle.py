@@ -164,4 +164,5 @@ def main():
           [i for i in impacts if i['own'] is not None and i['rl'] is not None], edges)
 
 
-main()
+if __name__ == '__main__':
+    main()

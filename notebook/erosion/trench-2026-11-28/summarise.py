@@ -15,10 +15,11 @@ The factor is mean f(local) over the grains / f(nominal).
 Usage: python3 summarise.py incidence.tsv[.xz] columns.tsv[.xz]"""
 import csv, lzma, math, statistics as st, sys
 
+from by_angle import trench_angle
+
 GRIT = [(0, 0.0), (15, 0.66), (30, 0.83), (45, 1.0), (60, 1.71), (75, 1.82), (90, 2.06)]
 HV = 1.8
 N1, N2 = 0.71 * HV ** 0.14, 2.4 * HV ** -0.94
-SLOPE_HALF_WIDTH_DG = 0.1
 
 
 def grit_f(a):
@@ -40,12 +41,6 @@ def key(r):
 def q(v, p):
     v = sorted(v)
     return v[min(len(v) - 1, int(p * len(v)))]
-
-
-def slope(profile, xs, x0):
-    near = [x for x in xs if abs(x - x0) <= SLOPE_HALF_WIDTH_DG]
-    mx, my = st.mean(near), st.mean(profile[x] for x in near)
-    return sum((x - mx) * (profile[x] - my) for x in near) / sum((x - mx) ** 2 for x in near)
 
 
 def rows(path):
@@ -74,10 +69,7 @@ for k, g in sorted(groups.items()):
     shared = ''
     if k in tops:
         profile = {x: st.mean(v) for x, v in tops[k].items()}
-        xs = sorted(profile)
-        a = math.radians(ang)
-        mean_loc = [math.degrees(math.asin(abs(math.sin(
-            a + math.atan(slope(profile, xs, float(r['contact_x_dg']))))))) for r in g]
+        mean_loc = [trench_angle(profile, float(r['contact_x_dg']), ang) for r in g]
         shared = (f'{q(mean_loc, .1):.0f}° | {q(mean_loc, .5):.0f}° | {q(mean_loc, .9):.0f}° '
                   f'| {within(mean_loc):.0%}')
     else:
