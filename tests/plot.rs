@@ -513,7 +513,7 @@ fn the_resolution_ladder_places_each_file_by_its_spacing_and_judges_steadiness_n
     assert!(out.status.success(), "{stdout}");
     // The 16 rung's 45° cell passed the rule it ran under and fails the three-window rule.
     assert!(
-        stdout.contains("| 45° hexagon | 16.0 | 15.62 | 30 × 160 | 1.60 ± 0.20 | no |"),
+        stdout.contains("| 45° hexagon | 16.0 | 15.62 | 30 × 160 | 1.60 ± 0.20 | **unsteady** |"),
         "{stdout}"
     );
     assert!(
@@ -527,6 +527,30 @@ fn the_resolution_ladder_places_each_file_by_its_spacing_and_judges_steadiness_n
         2,
         "both 45° cells hollow"
     );
+    // Steady is not stationary: the 16 rung capped at 400 impacts is steady by the three
+    // windows, yet its loss is 78 % of the damage added, so both its points are hollow.
+    let capped = tempfile::tempdir().unwrap();
+    let out = grit(&[
+        "plot",
+        "--resolution",
+        root.join("docs/erosion/resolution/ppd16-balanced-results.json")
+            .to_str()
+            .unwrap(),
+        "--out",
+        capped.path().to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(
+        stdout.contains(
+            "| 45° hexagon | 16.0 | 15.62 | 15 × 260 | 3.02 ± 0.51 | steady, **unbalanced** |"
+        ),
+        "{stdout}"
+    );
+    let svg = std::fs::read_to_string(capped.path().join("erosion_vs_resolution.svg")).unwrap();
+    assert_eq!(circles(&svg, 5, "#1F77B4", true), 1, "the 45° cell hollow");
+    assert_eq!(circles(&svg, 5, "#1F77B4", false), 0, "no 45° cell filled");
+    assert!(svg.contains("2 steady, not balanced"), "the note says why");
     // A file without a spacing in its spec is refused by name.
     let quick = data("quick-results.json");
     let bad = grit(&["plot", "--resolution", quick.to_str().unwrap()]);

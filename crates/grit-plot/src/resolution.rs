@@ -1,20 +1,21 @@
 //! The resolution ladder (seed paper section 3.1: a rate holds only once it holds under
 //! refinement): each cell's erosion against particles per grain diameter, across results files
 //! of the same scene run at several spacings, with ±1 s.e. bars; hollow markers for cells that
-//! are not at steady state under this build's rule, whatever rule the file ran under.
+//! are no stationary rate under this build's rules, whatever rules the file ran under: not at
+//! steady state, still running, or steady with a damage balance that does not hold.
 
 use std::path::Path;
 
 use grit_erosion::impact::steady::reassess;
-use grit_erosion::models::compare::spec_number;
+use grit_erosion::models::compare::{balanced, spec_number, verdict};
 use grit_erosion::CampaignResults;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::charts::legend_box;
 use crate::draw::{
-    axes, colour, de, error_bar, marker_style, prepare_output, save, steady_notes, top, with_notes,
-    DrawResult, Figure,
+    axes, colour, de, error_bar, marker_style, prepare_output, save, top, with_notes, DrawResult,
+    Figure,
 };
 use crate::{PlotError, Report};
 
@@ -43,6 +44,23 @@ pub struct LadderPoint {
     /// The cell's steady-state verdict under this build's rule (`steady::reassess`); `None`
     /// where the file cannot settle it.
     pub steady: Option<bool>,
+    /// Whether its last window's loss pays for the damage added, by this build's rule
+    /// (`DamageBalance::holds`); `None` where the file has no balance.
+    pub balanced: Option<bool>,
+    /// Whether samples or impacts are missing against the plan (a campaign still running).
+    pub partial: bool,
+}
+
+impl LadderPoint {
+    /// Whether the point is a stationary rate: a finished cell at steady state whose damage
+    /// balance, where the file has one, holds (docs/erosion.md, *The damage balance*); `None`
+    /// where steadiness cannot be settled.
+    pub fn stationary(&self) -> Option<bool> {
+        if self.partial {
+            return Some(false);
+        }
+        self.steady.map(|s| s && self.balanced != Some(false))
+    }
 }
 
 /// The material's name in the stored spec: a preset's name, or the `name` of a full material.
@@ -100,6 +118,8 @@ pub fn ladder(files: &[(String, CampaignResults)]) -> Result<Vec<LadderPoint>, P
                 samples: c.samples,
                 impacts: c.per_sample.iter().map(|s| s.impacts).max().unwrap_or(0),
                 steady: reassess(c).and_then(|r| r.steady()),
+                balanced: balanced(c),
+                partial: c.partial,
             });
         }
     }
@@ -109,16 +129,11 @@ pub fn ladder(files: &[(String, CampaignResults)]) -> Result<Vec<LadderPoint>, P
 /// The ladder as a Markdown table, one row per point, series by series in first-seen order.
 pub fn ladder_table(points: &[LadderPoint]) -> String {
     let mut s = String::from(
-        "| cell | per Dg | Δx (µm) | samples × impacts | erosion (mg/g) ± s.e. | steady | file |\n\
+        "| cell | per Dg | Δx (µm) | samples × impacts | erosion (mg/g) ± s.e. | verdict | file |\n\
          |---|---|---|---|---|---|---|\n",
     );
     for name in series_names(points) {
         for p in points.iter().filter(|p| p.series == name) {
-            let steady = match p.steady {
-                Some(true) => "yes",
-                Some(false) => "no",
-                None => "cannot tell",
-            };
             s.push_str(&format!(
                 "| {} | {:.1} | {:.2} | {} × {} | {:.2} ± {:.2} | {} | {} |\n",
                 p.series,
@@ -128,7 +143,7 @@ pub fn ladder_table(points: &[LadderPoint]) -> String {
                 p.impacts,
                 p.erosion * MG_PER_G,
                 p.sem * MG_PER_G,
-                steady,
+                verdict(p.steady, p.balanced, p.partial),
                 p.file
             ));
         }
@@ -178,7 +193,7 @@ impl Figure for Ladder<'_> {
                     .draw_series(std::iter::once(Circle::new(
                         (p.per_dg, e),
                         5,
-                        marker_style(c, p.steady),
+                        marker_style(c, p.stationary()),
                     )))
                     .map_err(de)?;
             }
@@ -192,8 +207,45 @@ impl Figure for Ladder<'_> {
                 .label(format!("{name}, bars ±1 s.e."))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], line));
         }
-        legend_box(&mut chart, SeriesLabelPosition::UpperRight)
+        legend_box(&mut chart, SeriesLabelPosition::LowerRight)
     }
+}
+
+/// The note under the ladder saying which points are drawn hollow and why; empty when every
+/// point is a stationary rate.
+fn ladder_notes(points: &[LadderPoint]) -> Vec<String> {
+    let total = points.len();
+    let count = |f: &dyn Fn(&LadderPoint) -> bool| points.iter().filter(|p| f(p)).count();
+    let running = count(&|p| p.partial);
+    let unsteady = count(&|p| !p.partial && p.steady == Some(false));
+    let unbalanced = count(&|p| !p.partial && p.steady == Some(true) && p.balanced == Some(false));
+    let unchecked = count(&|p| !p.partial && p.steady.is_none());
+    let mut why = Vec::new();
+    for (n, what) in [
+        (running, "still running"),
+        (unsteady, "not steady"),
+        (unbalanced, "steady, not balanced"),
+    ] {
+        if n > 0 {
+            why.push(format!("{n} {what}"));
+        }
+    }
+    let mut notes = Vec::new();
+    if !why.is_empty() {
+        notes.push(format!(
+            "Hollow markers: {} of {total} cells are no stationary rate yet: {} \
+             (docs/erosion.md, The damage balance).",
+            running + unsteady + unbalanced,
+            why.join(", ")
+        ));
+    }
+    if unchecked > 0 {
+        notes.push(format!(
+            "Steady state not checked for {unchecked} of {total} cells (results written \
+             before the check): drawn filled."
+        ));
+    }
+    notes
 }
 
 /// Writes `erosion_vs_resolution` (PNG and SVG) into `out` from the ladder's points.
@@ -208,7 +260,7 @@ pub fn plot_ladder(points: &[LadderPoint], out: &Path) -> Result<Report, PlotErr
     }
     let fig = Ladder {
         points,
-        notes: steady_notes(points.iter().map(|p| p.steady)),
+        notes: ladder_notes(points),
     };
     report
         .files
@@ -234,6 +286,64 @@ mod tests {
         let r = results(serde_json::json!({"grain": {"diameter_m": 2.5e-4}}));
         let e = ladder(&[("a.json".into(), r)]).unwrap_err().to_string();
         assert!(e.contains("a.json") && e.contains("spacing_m"), "{e}");
+    }
+
+    fn point(steady: Option<bool>, balanced: Option<bool>, partial: bool) -> LadderPoint {
+        LadderPoint {
+            file: "f.json".into(),
+            per_dg: 32.0,
+            spacing_m: 7.8125e-6,
+            series: "45° hexagon".into(),
+            erosion: 4e-3,
+            sem: 2e-4,
+            samples: 25,
+            impacts: 420,
+            steady,
+            balanced,
+            partial,
+        }
+    }
+
+    #[test]
+    fn only_a_finished_steady_cell_whose_balance_holds_is_a_stationary_rate() {
+        assert_eq!(
+            point(Some(true), Some(true), false).stationary(),
+            Some(true)
+        );
+        assert_eq!(point(Some(true), None, false).stationary(), Some(true));
+        assert_eq!(
+            point(Some(true), Some(false), false).stationary(),
+            Some(false)
+        );
+        assert_eq!(
+            point(Some(false), Some(true), false).stationary(),
+            Some(false)
+        );
+        assert_eq!(
+            point(Some(true), Some(true), true).stationary(),
+            Some(false)
+        );
+        assert_eq!(point(None, None, false).stationary(), None);
+        let table = ladder_table(&[point(Some(true), Some(false), false)]);
+        assert!(table.contains("| steady, **unbalanced** |"), "{table}");
+    }
+
+    #[test]
+    fn the_note_counts_each_reason_a_point_is_hollow() {
+        let points = [
+            point(Some(true), Some(true), false),
+            point(Some(true), Some(false), false),
+            point(Some(false), None, false),
+            point(Some(true), Some(true), true),
+        ];
+        let notes = ladder_notes(&points);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].starts_with("Hollow markers: 3 of 4 cells")
+                && notes[0].contains("1 still running, 1 not steady, 1 steady, not balanced"),
+            "{notes:?}"
+        );
+        assert!(ladder_notes(&points[..1]).is_empty());
     }
 
     #[test]

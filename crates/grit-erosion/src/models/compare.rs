@@ -314,9 +314,10 @@ fn steady(c: &CellResult) -> Option<bool> {
     c.steady_state.as_ref().map(|s| s.steady)
 }
 
-/// By the current rule, whatever the file says: results written before the ratio floor
-/// called some cells balanced that are not.
-fn balanced(c: &CellResult) -> Option<bool> {
+/// Whether a cell's last window is balanced (docs/erosion.md, *The damage balance*), by the
+/// current rule whatever the file says: results written before the ratio floor called some
+/// cells balanced that are not.
+pub fn balanced(c: &CellResult) -> Option<bool> {
     c.damage_balance.as_ref().map(|b| b.holds())
 }
 
@@ -487,7 +488,7 @@ fn yes_no(v: Option<bool>, yes: &str, no: &str) -> String {
 /// A cell's verdicts: the steady rule's, then, for a steady cell with a damage balance,
 /// whether its loss pays for the damage added (docs/erosion.md, *The damage balance*). A
 /// partial cell has none yet: its rule looked at samples that are still running.
-fn verdict(steady: Option<bool>, balanced: Option<bool>, partial: bool) -> String {
+pub fn verdict(steady: Option<bool>, balanced: Option<bool>, partial: bool) -> String {
     if partial {
         return "partial".into();
     }
