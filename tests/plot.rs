@@ -258,6 +258,41 @@ fn circles(svg: &str, r: u32, colour: &str, hollow: bool) -> usize {
 }
 
 #[test]
+fn a_steady_cell_whose_loss_does_not_pay_for_its_damage_is_drawn_hollow() {
+    let mut v = synthetic_results();
+    for c in v["cells"].as_array_mut().unwrap() {
+        c["steady_state"]["steady"] = serde_json::Value::Bool(true);
+    }
+    // Cell 8 (hexagon, 45°) loses 40 % of the damage its impacts add, 15 s.e. short.
+    v["cells"][8]["damage_balance"] = serde_json::json!({
+        "balanced": false, "damage_rate": 5e-3, "damage_rate_sem": 1e-4, "detectable_rel": 0.1,
+        "difference_sem": 2e-4, "loss_rate": 2e-3, "loss_rate_sem": 1.7e-4, "points": 20,
+        "ratio": 0.4, "samples": 3
+    });
+    v["steady"] = serde_json::Value::Bool(true);
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("results.json");
+    std::fs::write(&path, v.to_string()).unwrap();
+    let (dir, stdout) = plot(&path);
+    let svg = std::fs::read_to_string(dir.path().join("erosion_vs_angle.svg")).unwrap();
+    assert_eq!(
+        circles(&svg, 5, "#FF7F0E", true),
+        1,
+        "the unbalanced cell hollow"
+    );
+    assert!(svg.contains("hollow: not steady or not balanced"), "legend");
+    assert!(svg.contains("Hollow markers: 1 of 18 cells"), "note");
+    let cell = std::fs::read_to_string(dir.path().join("mass_loss_c08_45deg_hexagon.svg")).unwrap();
+    assert_eq!(
+        circles(&cell, 3, "#000000", true),
+        21,
+        "window marks hollow"
+    );
+    assert!(cell.contains("Not balanced (docs/erosion.md, The damage balance)"));
+    assert!(stdout.contains("(steady, not balanced)"), "{stdout}");
+}
+
+#[test]
 fn unsteady_cells_are_drawn_hollow_with_a_note() {
     let mut v = synthetic_results();
     // Every cell steady but the hexagon's at 45° (cell 8), whatever the noise made of them.
@@ -291,7 +326,7 @@ fn unsteady_cells_are_drawn_hollow_with_a_note() {
             "{chart}: the others filled"
         );
         assert!(
-            svg.contains("hollow: not at steady state"),
+            svg.contains("hollow: not steady or not balanced"),
             "{chart}: legend"
         );
         assert!(

@@ -28,7 +28,8 @@ pub struct Point {
     pub mean: f64,
     /// Sample standard deviation, when 2 samples or more.
     pub std: Option<f64>,
-    /// Whether the cell is at steady state (section 4); `None` in files before the check.
+    /// Whether the cell's erosion is a stationary rate, steady and balanced
+    /// (`CellResult::stationary`); `None` in files before the steady check.
     pub steady: Option<bool>,
 }
 
@@ -78,7 +79,7 @@ pub struct Analysis {
     pub modified: Result<Modified, String>,
     /// Fit parameters and skip reasons, in words.
     pub notes: Vec<String>,
-    /// How the angle charts draw cells not at steady state, when any are drawn.
+    /// How the angle charts draw cells that are no stationary rate, when any are drawn.
     pub steady_notes: Vec<String>,
 }
 
@@ -114,7 +115,7 @@ impl Analysis {
                 angle_deg: c.angle_deg,
                 mean,
                 std: c.erosion_std,
-                steady: c.steady_state.as_ref().map(|s| s.steady),
+                steady: c.stationary(),
             };
             match series.iter_mut().find(|s| s.label == label) {
                 Some(s) => s.points.push(point),

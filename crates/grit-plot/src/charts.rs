@@ -111,20 +111,21 @@ fn dash_key(
     move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 22, y)], dash, gap, style)
 }
 
-/// A legend entry for the hollow markers of cells not at steady state, when any is drawn.
+/// A legend entry for the hollow markers of cells whose erosion is no stationary rate, when any
+/// is drawn.
 fn hollow_key<DB: DrawingBackend>(chart: &mut Axes<'_, DB>, any: bool) -> DrawResult {
     if any {
         let style = marker_style(RGBColor(90, 90, 90), Some(false));
         chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
             .map_err(de)?
-            .label("hollow: not at steady state (docs/erosion.md)")
+            .label("hollow: not steady or not balanced (docs/erosion.md)")
             .legend(move |(x, y)| Circle::new((x + 11, y), 5, style));
     }
     Ok(())
 }
 
-/// Whether any of `steady` is a cell that failed the steady-state check.
+/// Whether any of `steady` is a cell whose erosion is no stationary rate.
 fn any_unsteady(mut steady: impl Iterator<Item = Option<bool>>) -> bool {
     steady.any(|s| s == Some(false))
 }
@@ -211,7 +212,7 @@ impl Figure for MassLoss<'_> {
             .legend(line_key(bold));
         if mean.len() >= self.window && self.window >= 2 {
             let tail = &mean[mean.len() - self.window..];
-            let steady = c.steady_state.as_ref().map(|s| s.steady);
+            let steady = c.stationary();
             let marks = marker_style(BLACK, steady);
             chart
                 .draw_series(tail.iter().map(|p| Circle::new((p.0, p.1), 3, marks)))
@@ -220,7 +221,7 @@ impl Figure for MassLoss<'_> {
                     "last {} points (erosion window){}",
                     self.window,
                     if steady == Some(false) {
-                        ", hollow: not at steady state"
+                        ", hollow: not steady or not balanced"
                     } else {
                         ""
                     }
@@ -321,6 +322,12 @@ pub fn mass_loss(
                 notes.push("Steady state not checked (results written before the check).".into())
             }
         }
+        if let Some(b) = c.damage_balance.filter(|b| !b.holds()) {
+            notes.push(format!(
+                "Not balanced (docs/erosion.md, The damage balance): {}",
+                b.describe()
+            ));
+        }
         let fig = MassLoss {
             cell: c,
             samples,
@@ -341,7 +348,7 @@ struct AngleCurve {
     angle_deg: f64,
     /// Cumulative (grain g/m, loss mg/m).
     points: Vec<(f64, f64)>,
-    /// The cell's steady state; `None` when not checked.
+    /// Whether the cell's erosion is a stationary rate; `None` when not checked.
     steady: Option<bool>,
 }
 
@@ -437,7 +444,7 @@ pub fn sample_by_angle(
                     AngleCurve {
                         angle_deg: c.angle_deg,
                         points: sample_curve(r),
-                        steady: c.steady_state.as_ref().map(|s| s.steady),
+                        steady: c.stationary(),
                     }
                 })
                 .collect();
@@ -851,7 +858,7 @@ impl Figure for Convergence<'_> {
                 .iter()
                 .filter(|c| !c.convergence.is_empty())
         };
-        let steady = |c: &CellResult| c.steady_state.as_ref().map(|s| s.steady);
+        let steady = |c: &CellResult| c.stationary();
         let area = with_notes(root, &steady_notes(cells().map(steady)))?;
         let values = || {
             cells().flat_map(|c| {

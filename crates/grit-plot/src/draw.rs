@@ -219,9 +219,10 @@ pub fn file_safe(s: &str) -> String {
 /// Width of a hollow marker's outline, pixels.
 const HOLLOW_STROKE: u32 = 2;
 
-/// A cell's marker: hollow (outline only) when the cell is not at steady state, whose
-/// last-20 slope mixes in incubation (seed paper section 4; `docs/erosion.md`, *Steady
-/// state*); filled when it is, or when the file predates the check (`None`).
+/// A cell's marker: hollow (outline only) when the cell's erosion is no stationary rate, its
+/// last-20 slope mixing in incubation (seed paper section 4; `docs/erosion.md`, *Steady
+/// state*) or its loss not yet paying for the damage added (*The damage balance*); filled
+/// when it is one, or when the file predates the check (`None`).
 pub fn marker_style(c: RGBColor, steady: Option<bool>) -> ShapeStyle {
     if steady == Some(false) {
         c.stroke_width(HOLLOW_STROKE)
@@ -230,8 +231,9 @@ pub fn marker_style(c: RGBColor, steady: Option<bool>) -> ShapeStyle {
     }
 }
 
-/// The note under a chart of per-cell erosion saying how unsteady cells are drawn and which
-/// were never checked; empty when every cell drawn is steady.
+/// The note under a chart of per-cell erosion saying how cells that are no stationary rate
+/// (`CellResult::stationary`) are drawn and which were never checked; empty when every cell
+/// drawn is one.
 pub fn steady_notes(steady: impl Iterator<Item = Option<bool>>) -> Vec<String> {
     let (mut total, mut unsteady, mut unchecked) = (0, 0, 0);
     for s in steady {
@@ -245,8 +247,8 @@ pub fn steady_notes(steady: impl Iterator<Item = Option<bool>>) -> Vec<String> {
     let mut notes = Vec::new();
     if unsteady > 0 {
         notes.push(format!(
-            "Hollow markers: {unsteady} of {total} cells not at steady state; their last-20 \
-             slope is no steady erosion rate (docs/erosion.md, Steady state)."
+            "Hollow markers: {unsteady} of {total} cells not steady or not balanced: their \
+             last-20 slope is no stationary rate (docs/erosion.md, The damage balance)."
         ));
     }
     if unchecked > 0 {
@@ -279,7 +281,7 @@ mod tests {
         assert!(steady_notes([Some(true), Some(true)].into_iter()).is_empty());
         let n = steady_notes([Some(true), Some(false), None].into_iter());
         assert_eq!(n.len(), 2);
-        assert!(n[0].starts_with("Hollow markers: 1 of 3 cells not at steady state"));
+        assert!(n[0].starts_with("Hollow markers: 1 of 3 cells not steady or not balanced"));
         assert!(n[1].starts_with("Steady state not checked for 1 of 3 cells"));
     }
 }

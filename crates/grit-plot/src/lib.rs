@@ -132,8 +132,9 @@ pub fn summary_table(results: &CampaignResults) -> String {
             fmt(c.erosion_mean),
             fmt(c.erosion_std),
             if c.partial { "  (partial)" } else { "" },
-            match &c.steady_state {
-                Some(s) if !s.steady => "  (not at steady state)",
+            match (&c.steady_state, c.stationary()) {
+                (Some(s), _) if !s.steady => "  (not at steady state)",
+                (_, Some(false)) => "  (steady, not balanced)",
                 _ => "",
             }
         ));

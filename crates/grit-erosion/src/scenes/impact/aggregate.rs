@@ -170,6 +170,14 @@ impl CellResult {
         self.angle_deg == other.angle_deg && self.shape == other.shape && self.swept == other.swept
     }
 
+    /// Whether the cell's erosion is a stationary rate (docs/erosion.md, *The damage
+    /// balance*): at steady state and, where the records carry damage, with its loss paying for
+    /// the damage its impacts add by the current rule; `None` where steadiness was not checked.
+    pub fn stationary(&self) -> Option<bool> {
+        let steady = self.steady_state.as_ref()?.steady;
+        Some(steady && self.damage_balance.is_none_or(|b| b.holds()))
+    }
+
     /// The cell's name in messages: angle, shape and any other swept values.
     pub fn label(&self) -> String {
         let mut label = format!("{}° {}", self.angle_deg, self.shape);
