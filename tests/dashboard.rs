@@ -387,7 +387,9 @@ async fn chromium_shows_a_finished_campaign_its_chart_workers_and_failed_jobs() 
             .replace('&', "&amp;")
             .replace('<', "&lt;")
             .replace('>', "&gt;");
-        if !note.contains("Hollow points: not at steady state or not balanced") || !note.contains(&shown) {
+        if !note.contains("Hollow points: not at steady state or not balanced")
+            || !note.contains(&shown)
+        {
             fail(&format!("the note with the reason `{reason}`"));
         }
         assert!(reason.starts_with("reached max 20 impacts"), "{reason}");
