@@ -531,21 +531,28 @@ fn a_fit_document_is_drawn_as_its_model_through_its_cells() {
 #[test]
 fn the_resolution_ladder_places_each_file_by_its_spacing_and_judges_steadiness_now() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // `grit plot --resolution` on committed files into `out`; its stdout, the ladder's table.
+    let ladder = |files: &[&str], out: &Path| {
+        let mut args = vec!["plot".to_string(), "--resolution".into()];
+        args.extend(
+            files
+                .iter()
+                .map(|f| root.join(f).to_str().unwrap().to_string()),
+        );
+        args.extend(["--out".into(), out.to_str().unwrap().to_string()]);
+        let out = grit(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(out.status.success(), "{stdout}");
+        stdout
+    };
     let dir = tempfile::tempdir().unwrap();
-    let out = grit(&[
-        "plot",
-        "--resolution",
-        root.join("docs/erosion/resolution/ppd16-seed-results.json")
-            .to_str()
-            .unwrap(),
-        root.join("docs/erosion/resolution24-results.json")
-            .to_str()
-            .unwrap(),
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}");
+    let stdout = ladder(
+        &[
+            "docs/erosion/resolution/ppd16-seed-results.json",
+            "docs/erosion/resolution24-results.json",
+        ],
+        dir.path(),
+    );
     // The 16 rung's 45° cell passed the rule it ran under and fails the three-window rule.
     assert!(
         stdout.contains("| 45° hexagon | 16.0 | 15.62 | 30 × 160 | 1.60 ± 0.20 | **unsteady** |"),
@@ -565,17 +572,10 @@ fn the_resolution_ladder_places_each_file_by_its_spacing_and_judges_steadiness_n
     // Steady is not stationary: the 16 rung capped at 400 impacts is steady by the three
     // windows, yet its loss is 78 % of the damage added, so both its points are hollow.
     let capped = tempfile::tempdir().unwrap();
-    let out = grit(&[
-        "plot",
-        "--resolution",
-        root.join("docs/erosion/resolution/ppd16-balanced-results.json")
-            .to_str()
-            .unwrap(),
-        "--out",
-        capped.path().to_str().unwrap(),
-    ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}");
+    let stdout = ladder(
+        &["docs/erosion/resolution/ppd16-balanced-results.json"],
+        capped.path(),
+    );
     assert!(
         stdout.contains(
             "| 45° hexagon | 16.0 | 15.62 | 15 × 260 | 3.02 ± 0.51 | steady, **unbalanced** |"
