@@ -3,7 +3,9 @@
 #   charts.sh GRIT OUT RUN_DIR…
 # GRIT: a grit binary with the balance chart (commit fd9ed8b or later); it serves the copy
 # read-only on a free local port, fetches the results with every sample's series and draws
-# them; OUT/<campaign>/ gets the damage_balance_*.png charts.
+# them; OUT/<campaign>/ gets the damage_balance_*.png charts. With RESULTS_DIR set, the
+# campaign's results without the per-impact series are also written to RESULTS_DIR/<campaign>.json
+# (the snapshots that docs/results.md quotes).
 set -euo pipefail
 grit=$1
 out=$2
@@ -23,6 +25,9 @@ for run in "$@"; do
   id=$(awk 'NR == 1 {print $1}' "$tmp/$name.status")
   mkdir -p "$out/$name"
   "$grit" results "$id" --raw -o "$tmp/$name.json" --coordinator http://127.0.0.1:$port > /dev/null
+  if [ -n "${RESULTS_DIR:-}" ]; then
+    "$grit" results "$id" -o "$RESULTS_DIR/$name.json" --coordinator http://127.0.0.1:$port > /dev/null
+  fi
   kill $pid
   "$grit" plot "$tmp/$name.json" --out "$tmp/charts-$name" > /dev/null
   cp "$tmp"/charts-$name/damage_balance_*.png "$out/$name/"
