@@ -30,7 +30,7 @@ pub struct Point {
     pub std: Option<f64>,
     /// Whether the cell's erosion is a stationary rate, steady and balanced
     /// (`CellResult::stationary`); `None` in files before the steady check.
-    pub steady: Option<bool>,
+    pub stationary: Option<bool>,
 }
 
 /// Oka's model for one series, or why not.
@@ -80,7 +80,7 @@ pub struct Analysis {
     /// Fit parameters and skip reasons, in words.
     pub notes: Vec<String>,
     /// How the angle charts draw cells that are no stationary rate, when any are drawn.
-    pub steady_notes: Vec<String>,
+    pub hollow_notes: Vec<String>,
 }
 
 /// Hardness of the surface the Oka curves use (the seed's AISI 304).
@@ -115,7 +115,7 @@ impl Analysis {
                 angle_deg: c.angle_deg,
                 mean,
                 std: c.erosion_std,
-                steady: c.stationary(),
+                stationary: c.stationary(),
             };
             match series.iter_mut().find(|s| s.label == label) {
                 Some(s) => s.points.push(point),
@@ -191,16 +191,16 @@ impl Analysis {
             },
             Err(e) => notes.push(format!("no modified-Oka chart: {e}")),
         }
-        let steady_notes = crate::draw::steady_notes(
+        let hollow_notes = crate::draw::hollow_notes(
             series
                 .iter()
-                .flat_map(|s| s.points.iter().map(|p| p.steady)),
+                .flat_map(|s| s.points.iter().map(|p| p.stationary)),
         );
         Analysis {
             series,
             modified,
             notes,
-            steady_notes,
+            hollow_notes,
         }
     }
 }

@@ -13,8 +13,8 @@ use plotters::prelude::*;
 
 use crate::analysis::{series_label, Analysis, Series, HV_GPA};
 use crate::draw::{
-    chart_on, colour, de, draw_mesh, error_bar, file_safe, line_key, marker_style, save,
-    steady_notes, top, with_notes, Axes, DrawResult, Figure, FONT,
+    chart_on, colour, de, draw_mesh, error_bar, file_safe, hollow_notes, line_key, marker_style,
+    save, top, with_notes, Axes, DrawResult, Figure, FONT,
 };
 use crate::{PlotError, PlotInput, RawSeries, Report};
 
@@ -125,9 +125,9 @@ fn hollow_key<DB: DrawingBackend>(chart: &mut Axes<'_, DB>, any: bool) -> DrawRe
     Ok(())
 }
 
-/// Whether any of `steady` is a cell whose erosion is no stationary rate.
-fn any_unsteady(mut steady: impl Iterator<Item = Option<bool>>) -> bool {
-    steady.any(|s| s == Some(false))
+/// Whether any of `stationary` is a cell whose erosion is no stationary rate.
+fn any_hollow(mut stationary: impl Iterator<Item = Option<bool>>) -> bool {
+    stationary.any(|s| s == Some(false))
 }
 
 /// A sample's cumulative (grain g/m, loss mg/m), in impact order.
@@ -212,15 +212,15 @@ impl Figure for MassLoss<'_> {
             .legend(line_key(bold));
         if mean.len() >= self.window && self.window >= 2 {
             let tail = &mean[mean.len() - self.window..];
-            let steady = c.stationary();
-            let marks = marker_style(BLACK, steady);
+            let stationary = c.stationary();
+            let marks = marker_style(BLACK, stationary);
             chart
                 .draw_series(tail.iter().map(|p| Circle::new((p.0, p.1), 3, marks)))
                 .map_err(de)?
                 .label(format!(
                     "last {} points (erosion window){}",
                     self.window,
-                    if steady == Some(false) {
+                    if stationary == Some(false) {
                         ", hollow: not steady or not balanced"
                     } else {
                         ""
@@ -349,7 +349,7 @@ struct AngleCurve {
     /// Cumulative (grain g/m, loss mg/m).
     points: Vec<(f64, f64)>,
     /// Whether the cell's erosion is a stationary rate; `None` when not checked.
-    steady: Option<bool>,
+    stationary: Option<bool>,
 }
 
 struct SampleAngles {
@@ -381,7 +381,7 @@ impl Figure for SampleAngles {
                 .label(format!("{angle}°"))
                 .legend(line_key(line));
             if pts.len() >= self.window && self.window >= 2 {
-                let marks = marker_style(colour(i), curve.steady);
+                let marks = marker_style(colour(i), curve.stationary);
                 chart
                     .draw_series(
                         pts[pts.len() - self.window..]
@@ -393,7 +393,7 @@ impl Figure for SampleAngles {
         }
         hollow_key(
             &mut chart,
-            any_unsteady(self.curves.iter().map(|c| c.steady)),
+            any_hollow(self.curves.iter().map(|c| c.stationary)),
         )?;
         legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
     }
@@ -444,7 +444,7 @@ pub fn sample_by_angle(
                     AngleCurve {
                         angle_deg: c.angle_deg,
                         points: sample_curve(r),
-                        steady: c.stationary(),
+                        stationary: c.stationary(),
                     }
                 })
                 .collect();
@@ -455,7 +455,7 @@ pub fn sample_by_angle(
             let mut notes = vec![format!(
                 "Dots: the last {window} impacts, whose slope is the sample's erosion."
             )];
-            notes.extend(steady_notes(curves.iter().map(|c| c.steady)));
+            notes.extend(hollow_notes(curves.iter().map(|c| c.stationary)));
             let fig = SampleAngles {
                 label: label.clone(),
                 sample: k,
@@ -546,7 +546,7 @@ impl Figure for Angle<'_> {
                     Circle::new(
                         (p.angle_deg, p.mean * MG_PER_G),
                         5,
-                        marker_style(c, p.steady),
+                        marker_style(c, p.stationary),
                     )
                 }))
                 .map_err(de)?;
@@ -578,7 +578,7 @@ impl Figure for Angle<'_> {
             }
         }
         let drawn = self.an.series.iter().flat_map(|s| &s.points);
-        hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
+        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationary)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -603,7 +603,7 @@ pub fn erosion_vs_angle(
             .notes
             .iter()
             .filter(|n| !n.starts_with("modified Oka") && !n.starts_with("no modified"))
-            .chain(&an.steady_notes)
+            .chain(&an.hollow_notes)
             .cloned()
             .collect(),
     };
@@ -635,7 +635,7 @@ impl Figure for Normalised<'_> {
                     p.mean / e45,
                     d / e45,
                     p.std.is_some(),
-                    p.steady,
+                    p.stationary,
                 )
             })
         };
@@ -690,7 +690,7 @@ impl Figure for Normalised<'_> {
             .shown
             .iter()
             .flat_map(|&(i, _)| &self.an.series[i].points);
-        hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
+        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationary)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -719,10 +719,10 @@ pub fn normalised(
         return Ok(());
     }
     let mut chart_notes = notes.clone();
-    chart_notes.extend(steady_notes(
+    chart_notes.extend(hollow_notes(
         shown
             .iter()
-            .flat_map(|&(i, _)| an.series[i].points.iter().map(|p| p.steady)),
+            .flat_map(|&(i, _)| an.series[i].points.iter().map(|p| p.stationary)),
     ));
     let fig = Normalised {
         an,
@@ -791,7 +791,7 @@ impl Figure for ModifiedChart<'_> {
                     Circle::new(
                         (p.angle_deg, p.mean * MG_PER_G),
                         5,
-                        marker_style(c, p.steady),
+                        marker_style(c, p.stationary),
                     )
                 }))
                 .map_err(de)?
@@ -812,7 +812,7 @@ impl Figure for ModifiedChart<'_> {
                 .legend(dash_key(line, 7, 4));
         }
         let drawn = m.series.iter().flat_map(|&i| &self.an.series[i].points);
-        hollow_key(&mut chart, any_unsteady(drawn.map(|p| p.steady)))?;
+        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationary)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -833,10 +833,10 @@ pub fn modified_oka(
         .cloned()
         .collect();
     if let Ok(m) = &an.modified {
-        notes.extend(steady_notes(
+        notes.extend(hollow_notes(
             m.series
                 .iter()
-                .flat_map(|&i| an.series[i].points.iter().map(|p| p.steady)),
+                .flat_map(|&i| an.series[i].points.iter().map(|p| p.stationary)),
         ));
     }
     let fig = ModifiedChart { an, notes };
@@ -858,8 +858,8 @@ impl Figure for Convergence<'_> {
                 .iter()
                 .filter(|c| !c.convergence.is_empty())
         };
-        let steady = |c: &CellResult| c.stationary();
-        let area = with_notes(root, &steady_notes(cells().map(steady)))?;
+        let stationary = |c: &CellResult| c.stationary();
+        let area = with_notes(root, &hollow_notes(cells().map(stationary)))?;
         let values = || {
             cells().flat_map(|c| {
                 c.convergence.iter().flat_map(|p| {
@@ -920,7 +920,7 @@ impl Figure for Convergence<'_> {
                     .iter()
                     .map(|p| (p.samples as f64, p.erosion_mean * MG_PER_G))
             };
-            let marks = marker_style(col, steady(c));
+            let marks = marker_style(col, stationary(c));
             chart
                 .draw_series(points().map(|p| Circle::new(p, 4, marks)))
                 .map_err(de)?;
@@ -933,7 +933,7 @@ impl Figure for Convergence<'_> {
                 ))
                 .legend(line_key(line));
         }
-        hollow_key(&mut chart, any_unsteady(cells().map(steady)))?;
+        hollow_key(&mut chart, any_hollow(cells().map(stationary)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }

@@ -219,12 +219,12 @@ pub fn file_safe(s: &str) -> String {
 /// Width of a hollow marker's outline, pixels.
 const HOLLOW_STROKE: u32 = 2;
 
-/// A cell's marker: hollow (outline only) when the cell's erosion is no stationary rate, its
-/// last-20 slope mixing in incubation (seed paper section 4; `docs/erosion.md`, *Steady
-/// state*) or its loss not yet paying for the damage added (*The damage balance*); filled
-/// when it is one, or when the file predates the check (`None`).
-pub fn marker_style(c: RGBColor, steady: Option<bool>) -> ShapeStyle {
-    if steady == Some(false) {
+/// A cell's marker: hollow (outline only) when its value is no rate (`Some(false)`): an
+/// impact cell not at steady state or not balanced (`CellResult::stationary`; seed paper
+/// section 4, `docs/erosion.md`), a jet cell whose stage-3 slope is not steady; filled
+/// otherwise, or when the file predates the check (`None`).
+pub fn marker_style(c: RGBColor, rate: Option<bool>) -> ShapeStyle {
+    if rate == Some(false) {
         c.stroke_width(HOLLOW_STROKE)
     } else {
         c.filled()
@@ -234,9 +234,9 @@ pub fn marker_style(c: RGBColor, steady: Option<bool>) -> ShapeStyle {
 /// The note under a chart of per-cell erosion saying how cells that are no stationary rate
 /// (`CellResult::stationary`) are drawn and which were never checked; empty when every cell
 /// drawn is one.
-pub fn steady_notes(steady: impl Iterator<Item = Option<bool>>) -> Vec<String> {
+pub fn hollow_notes(stationary: impl Iterator<Item = Option<bool>>) -> Vec<String> {
     let (mut total, mut unsteady, mut unchecked) = (0, 0, 0);
-    for s in steady {
+    for s in stationary {
         total += 1;
         match s {
             Some(false) => unsteady += 1,
@@ -265,7 +265,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn only_unsteady_cells_are_hollow() {
+    fn only_cells_that_are_no_rate_are_hollow() {
         let c = colour(1);
         let hollow = marker_style(c, Some(false));
         assert!(!hollow.filled && hollow.stroke_width == HOLLOW_STROKE);
@@ -277,9 +277,9 @@ mod tests {
     }
 
     #[test]
-    fn notes_count_unsteady_and_unchecked_cells() {
-        assert!(steady_notes([Some(true), Some(true)].into_iter()).is_empty());
-        let n = steady_notes([Some(true), Some(false), None].into_iter());
+    fn notes_count_hollow_and_unchecked_cells() {
+        assert!(hollow_notes([Some(true), Some(true)].into_iter()).is_empty());
+        let n = hollow_notes([Some(true), Some(false), None].into_iter());
         assert_eq!(n.len(), 2);
         assert!(n[0].starts_with("Hollow markers: 1 of 3 cells not steady or not balanced"));
         assert!(n[1].starts_with("Steady state not checked for 1 of 3 cells"));

@@ -99,7 +99,7 @@ pub fn plot(input: &PlotInput, out: &Path) -> Result<Report, PlotError> {
     charts::modified_oka(&analysis, out, &mut report)?;
     charts::convergence(&input.results, out, &mut report)?;
     balance::damage_balance(input, out, &mut report)?;
-    report.notes.extend(analysis.steady_notes.iter().cloned());
+    report.notes.extend(analysis.hollow_notes.iter().cloned());
     Ok(report)
 }
 
