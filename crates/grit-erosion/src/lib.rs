@@ -16,7 +16,7 @@ pub use scenes::{impact, jet};
 
 pub use impact::aggregate::{
     aggregate_campaign, aggregate_cell, CampaignResults, CellInput, CellResult, Impact,
-    SampleInput, SLOPE_WINDOW,
+    SampleInput, Stationarity, SLOPE_WINDOW,
 };
 pub use impact::sample::{ImpactRecord, Sample, SampleError};
 pub use impact::steady::SteadyState;

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use grit_erosion::models::oka::{ErosionPoint, OkaFit, ShapedPoint};
 use grit_erosion::{
     fit_modified_oka, fit_oka, CampaignResults, ModifiedOkaModel, OkaModel, Shape, ShapeExponents,
-    ShapeReference, AISI304_HV_GPA,
+    ShapeReference, Stationarity, AISI304_HV_GPA,
 };
 
 /// "hexagon" or "hexagon, velocity_m_s 80": the shape and the cell's other swept values.
@@ -28,9 +28,9 @@ pub struct Point {
     pub mean: f64,
     /// Sample standard deviation, when 2 samples or more.
     pub std: Option<f64>,
-    /// Whether the cell's erosion is a stationary rate, steady and balanced
-    /// (`CellResult::stationary`); `None` in files before the steady check.
-    pub stationary: Option<bool>,
+    /// Whether the cell's erosion is a stationary rate, steady and balanced, and if not, why
+    /// (`CellResult::stationarity`).
+    pub stationarity: Stationarity,
 }
 
 /// Oka's model for one series, or why not.
@@ -115,7 +115,7 @@ impl Analysis {
                 angle_deg: c.angle_deg,
                 mean,
                 std: c.erosion_std,
-                stationary: c.stationary(),
+                stationarity: c.stationarity(),
             };
             match series.iter_mut().find(|s| s.label == label) {
                 Some(s) => s.points.push(point),
@@ -194,7 +194,7 @@ impl Analysis {
         let hollow_notes = crate::draw::hollow_notes(
             series
                 .iter()
-                .flat_map(|s| s.points.iter().map(|p| p.stationary)),
+                .flat_map(|s| s.points.iter().map(|p| p.stationarity)),
         );
         Analysis {
             series,

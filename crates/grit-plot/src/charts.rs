@@ -6,7 +6,7 @@
 use std::ops::Range;
 
 use grit_erosion::impact::aggregate::cumulative_series;
-use grit_erosion::{CampaignResults, CellResult};
+use grit_erosion::{CampaignResults, CellResult, Stationarity};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -125,9 +125,9 @@ fn hollow_key<DB: DrawingBackend>(chart: &mut Axes<'_, DB>, any: bool) -> DrawRe
     Ok(())
 }
 
-/// Whether any of `stationary` is a cell whose erosion is no stationary rate.
-fn any_hollow(mut stationary: impl Iterator<Item = Option<bool>>) -> bool {
-    stationary.any(|s| s == Some(false))
+/// Whether any of `cells` is a cell whose erosion is no stationary rate.
+fn any_hollow(mut cells: impl Iterator<Item = Stationarity>) -> bool {
+    cells.any(|s| s.is_rate() == Some(false))
 }
 
 /// A sample's cumulative (grain g/m, loss mg/m), in impact order.
@@ -348,8 +348,8 @@ struct AngleCurve {
     angle_deg: f64,
     /// Cumulative (grain g/m, loss mg/m).
     points: Vec<(f64, f64)>,
-    /// Whether the cell's erosion is a stationary rate; `None` when not checked.
-    stationary: Option<bool>,
+    /// Whether the cell's erosion is a stationary rate, and if not, why.
+    stationarity: Stationarity,
 }
 
 struct SampleAngles {
@@ -381,7 +381,7 @@ impl Figure for SampleAngles {
                 .label(format!("{angle}°"))
                 .legend(line_key(line));
             if pts.len() >= self.window && self.window >= 2 {
-                let marks = marker_style(colour(i), curve.stationary);
+                let marks = marker_style(colour(i), curve.stationarity.is_rate());
                 chart
                     .draw_series(
                         pts[pts.len() - self.window..]
@@ -393,7 +393,7 @@ impl Figure for SampleAngles {
         }
         hollow_key(
             &mut chart,
-            any_hollow(self.curves.iter().map(|c| c.stationary)),
+            any_hollow(self.curves.iter().map(|c| c.stationarity)),
         )?;
         legend_box(&mut chart, SeriesLabelPosition::UpperLeft)
     }
@@ -444,7 +444,7 @@ pub fn sample_by_angle(
                     AngleCurve {
                         angle_deg: c.angle_deg,
                         points: sample_curve(r),
-                        stationary: c.stationary(),
+                        stationarity: c.stationarity(),
                     }
                 })
                 .collect();
@@ -455,7 +455,7 @@ pub fn sample_by_angle(
             let mut notes = vec![format!(
                 "Dots: the last {window} impacts, whose slope is the sample's erosion."
             )];
-            notes.extend(hollow_notes(curves.iter().map(|c| c.stationary)));
+            notes.extend(hollow_notes(curves.iter().map(|c| c.stationarity)));
             let fig = SampleAngles {
                 label: label.clone(),
                 sample: k,
@@ -546,7 +546,7 @@ impl Figure for Angle<'_> {
                     Circle::new(
                         (p.angle_deg, p.mean * MG_PER_G),
                         5,
-                        marker_style(c, p.stationary),
+                        marker_style(c, p.stationarity.is_rate()),
                     )
                 }))
                 .map_err(de)?;
@@ -578,7 +578,7 @@ impl Figure for Angle<'_> {
             }
         }
         let drawn = self.an.series.iter().flat_map(|s| &s.points);
-        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationary)))?;
+        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationarity)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -635,7 +635,7 @@ impl Figure for Normalised<'_> {
                     p.mean / e45,
                     d / e45,
                     p.std.is_some(),
-                    p.stationary,
+                    p.stationarity.is_rate(),
                 )
             })
         };
@@ -690,7 +690,7 @@ impl Figure for Normalised<'_> {
             .shown
             .iter()
             .flat_map(|&(i, _)| &self.an.series[i].points);
-        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationary)))?;
+        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationarity)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -722,7 +722,7 @@ pub fn normalised(
     chart_notes.extend(hollow_notes(
         shown
             .iter()
-            .flat_map(|&(i, _)| an.series[i].points.iter().map(|p| p.stationary)),
+            .flat_map(|&(i, _)| an.series[i].points.iter().map(|p| p.stationarity)),
     ));
     let fig = Normalised {
         an,
@@ -791,7 +791,7 @@ impl Figure for ModifiedChart<'_> {
                     Circle::new(
                         (p.angle_deg, p.mean * MG_PER_G),
                         5,
-                        marker_style(c, p.stationary),
+                        marker_style(c, p.stationarity.is_rate()),
                     )
                 }))
                 .map_err(de)?
@@ -812,7 +812,7 @@ impl Figure for ModifiedChart<'_> {
                 .legend(dash_key(line, 7, 4));
         }
         let drawn = m.series.iter().flat_map(|&i| &self.an.series[i].points);
-        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationary)))?;
+        hollow_key(&mut chart, any_hollow(drawn.map(|p| p.stationarity)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
@@ -836,7 +836,7 @@ pub fn modified_oka(
         notes.extend(hollow_notes(
             m.series
                 .iter()
-                .flat_map(|&i| an.series[i].points.iter().map(|p| p.stationary)),
+                .flat_map(|&i| an.series[i].points.iter().map(|p| p.stationarity)),
         ));
     }
     let fig = ModifiedChart { an, notes };
@@ -858,8 +858,8 @@ impl Figure for Convergence<'_> {
                 .iter()
                 .filter(|c| !c.convergence.is_empty())
         };
-        let stationary = |c: &CellResult| c.stationary();
-        let area = with_notes(root, &hollow_notes(cells().map(stationary)))?;
+        let stationarity = |c: &CellResult| c.stationarity();
+        let area = with_notes(root, &hollow_notes(cells().map(stationarity)))?;
         let values = || {
             cells().flat_map(|c| {
                 c.convergence.iter().flat_map(|p| {
@@ -920,7 +920,7 @@ impl Figure for Convergence<'_> {
                     .iter()
                     .map(|p| (p.samples as f64, p.erosion_mean * MG_PER_G))
             };
-            let marks = marker_style(col, stationary(c));
+            let marks = marker_style(col, stationarity(c).is_rate());
             chart
                 .draw_series(points().map(|p| Circle::new(p, 4, marks)))
                 .map_err(de)?;
@@ -933,7 +933,7 @@ impl Figure for Convergence<'_> {
                 ))
                 .legend(line_key(line));
         }
-        hollow_key(&mut chart, any_hollow(cells().map(stationary)))?;
+        hollow_key(&mut chart, any_hollow(cells().map(stationarity)))?;
         legend_box(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }

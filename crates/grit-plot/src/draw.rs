@@ -9,6 +9,8 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use grit_erosion::Stationarity;
+
 use crate::PlotError;
 
 /// Size of every chart, pixels.
@@ -231,24 +233,37 @@ pub fn marker_style(c: RGBColor, rate: Option<bool>) -> ShapeStyle {
     }
 }
 
-/// The note under a chart of per-cell erosion saying how cells that are no stationary rate
-/// (`CellResult::stationary`) are drawn and which were never checked; empty when every cell
-/// drawn is one.
-pub fn hollow_notes(stationary: impl Iterator<Item = Option<bool>>) -> Vec<String> {
-    let (mut total, mut unsteady, mut unchecked) = (0, 0, 0);
-    for s in stationary {
+/// The note under a chart of per-cell erosion saying which cells are drawn hollow because they
+/// are no stationary rate (`CellResult::stationarity`), why, and which were never checked;
+/// empty when every cell drawn is one.
+pub fn hollow_notes(cells: impl Iterator<Item = Stationarity>) -> Vec<String> {
+    let (mut total, mut running, mut unsteady, mut unbalanced, mut unchecked) = (0, 0, 0, 0, 0);
+    for s in cells {
         total += 1;
         match s {
-            Some(false) => unsteady += 1,
-            None => unchecked += 1,
-            Some(true) => {}
+            Stationarity::Rate => {}
+            Stationarity::Running => running += 1,
+            Stationarity::Unsteady => unsteady += 1,
+            Stationarity::Unbalanced => unbalanced += 1,
+            Stationarity::Unchecked => unchecked += 1,
         }
     }
+    let why: Vec<String> = [
+        (running, "still running"),
+        (unsteady, "not steady"),
+        (unbalanced, "steady, not balanced"),
+    ]
+    .iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, what)| format!("{n} {what}"))
+    .collect();
     let mut notes = Vec::new();
-    if unsteady > 0 {
+    if !why.is_empty() {
         notes.push(format!(
-            "Hollow markers: {unsteady} of {total} cells not steady or not balanced: their \
-             last-20 slope is no stationary rate (docs/erosion.md, The damage balance)."
+            "Hollow markers: {} of {total} cells are no stationary rate yet: {} \
+             (docs/erosion.md, The damage balance).",
+            running + unsteady + unbalanced,
+            why.join(", ")
         ));
     }
     if unchecked > 0 {
@@ -278,10 +293,21 @@ mod tests {
 
     #[test]
     fn notes_count_hollow_and_unchecked_cells() {
-        assert!(hollow_notes([Some(true), Some(true)].into_iter()).is_empty());
-        let n = hollow_notes([Some(true), Some(false), None].into_iter());
+        use Stationarity::*;
+        assert!(hollow_notes([Rate, Rate].into_iter()).is_empty());
+        let n = hollow_notes([Rate, Unsteady, Unchecked].into_iter());
         assert_eq!(n.len(), 2);
-        assert!(n[0].starts_with("Hollow markers: 1 of 3 cells not steady or not balanced"));
+        assert!(n[0].starts_with(
+            "Hollow markers: 1 of 3 cells are no stationary rate yet: 1 not steady ("
+        ));
         assert!(n[1].starts_with("Steady state not checked for 1 of 3 cells"));
+        let n = hollow_notes([Running, Unbalanced, Unbalanced, Rate].into_iter());
+        assert_eq!(
+            n,
+            [
+                "Hollow markers: 3 of 4 cells are no stationary rate yet: 1 still running, 2 \
+              steady, not balanced (docs/erosion.md, The damage balance)."
+            ]
+        );
     }
 }

@@ -8,14 +8,14 @@ use std::path::Path;
 
 use grit_erosion::impact::steady::reassess;
 use grit_erosion::models::compare::{balanced, spec_number, verdict};
-use grit_erosion::CampaignResults;
+use grit_erosion::{CampaignResults, Stationarity};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::charts::legend_box;
 use crate::draw::{
-    axes, colour, de, error_bar, marker_style, prepare_output, save, top, with_notes, DrawResult,
-    Figure,
+    axes, colour, de, error_bar, hollow_notes, marker_style, prepare_output, save, top, with_notes,
+    DrawResult, Figure,
 };
 use crate::{PlotError, Report};
 
@@ -52,14 +52,10 @@ pub struct LadderPoint {
 }
 
 impl LadderPoint {
-    /// Whether the point is a stationary rate: a finished cell at steady state whose damage
-    /// balance, where the file has one, holds (docs/erosion.md, *The damage balance*); `None`
-    /// where steadiness cannot be settled.
-    pub fn stationary(&self) -> Option<bool> {
-        if self.partial {
-            return Some(false);
-        }
-        self.steady.map(|s| s && self.balanced != Some(false))
+    /// Whether the point is a stationary rate, by the rule `CellResult::stationarity` applies,
+    /// and only once its cell is finished.
+    pub fn stationarity(&self) -> Stationarity {
+        Stationarity::of(self.steady, self.balanced).unless_partial(self.partial)
     }
 }
 
@@ -193,7 +189,7 @@ impl Figure for Ladder<'_> {
                     .draw_series(std::iter::once(Circle::new(
                         (p.per_dg, e),
                         5,
-                        marker_style(c, p.stationary()),
+                        marker_style(c, p.stationarity().is_rate()),
                     )))
                     .map_err(de)?;
             }
@@ -211,43 +207,6 @@ impl Figure for Ladder<'_> {
     }
 }
 
-/// The note under the ladder saying which points are drawn hollow and why; empty when every
-/// point is a stationary rate.
-fn ladder_notes(points: &[LadderPoint]) -> Vec<String> {
-    let total = points.len();
-    let count = |f: &dyn Fn(&LadderPoint) -> bool| points.iter().filter(|p| f(p)).count();
-    let running = count(&|p| p.partial);
-    let unsteady = count(&|p| !p.partial && p.steady == Some(false));
-    let unbalanced = count(&|p| !p.partial && p.steady == Some(true) && p.balanced == Some(false));
-    let unchecked = count(&|p| !p.partial && p.steady.is_none());
-    let mut why = Vec::new();
-    for (n, what) in [
-        (running, "still running"),
-        (unsteady, "not steady"),
-        (unbalanced, "steady, not balanced"),
-    ] {
-        if n > 0 {
-            why.push(format!("{n} {what}"));
-        }
-    }
-    let mut notes = Vec::new();
-    if !why.is_empty() {
-        notes.push(format!(
-            "Hollow markers: {} of {total} cells are no stationary rate yet: {} \
-             (docs/erosion.md, The damage balance).",
-            running + unsteady + unbalanced,
-            why.join(", ")
-        ));
-    }
-    if unchecked > 0 {
-        notes.push(format!(
-            "Steady state not checked for {unchecked} of {total} cells (results written \
-             before the check): drawn filled."
-        ));
-    }
-    notes
-}
-
 /// Writes `erosion_vs_resolution` (PNG and SVG) into `out` from the ladder's points.
 pub fn plot_ladder(points: &[LadderPoint], out: &Path) -> Result<Report, PlotError> {
     prepare_output(out)?;
@@ -260,7 +219,7 @@ pub fn plot_ladder(points: &[LadderPoint], out: &Path) -> Result<Report, PlotErr
     }
     let fig = Ladder {
         points,
-        notes: ladder_notes(points),
+        notes: hollow_notes(points.iter().map(LadderPoint::stationarity)),
     };
     report
         .files
@@ -306,44 +265,17 @@ mod tests {
 
     #[test]
     fn only_a_finished_steady_cell_whose_balance_holds_is_a_stationary_rate() {
-        assert_eq!(
-            point(Some(true), Some(true), false).stationary(),
-            Some(true)
-        );
-        assert_eq!(point(Some(true), None, false).stationary(), Some(true));
-        assert_eq!(
-            point(Some(true), Some(false), false).stationary(),
-            Some(false)
-        );
-        assert_eq!(
-            point(Some(false), Some(true), false).stationary(),
-            Some(false)
-        );
-        assert_eq!(
-            point(Some(true), Some(true), true).stationary(),
-            Some(false)
-        );
-        assert_eq!(point(None, None, false).stationary(), None);
+        use Stationarity::*;
+        let of = |s, b, p| point(s, b, p).stationarity();
+        assert_eq!(of(Some(true), Some(true), false), Rate);
+        assert_eq!(of(Some(true), None, false), Rate);
+        assert_eq!(of(Some(true), Some(false), false), Unbalanced);
+        assert_eq!(of(Some(false), Some(true), false), Unsteady);
+        assert_eq!(of(Some(true), Some(true), true), Running);
+        assert_eq!(of(None, None, true), Running);
+        assert_eq!(of(None, None, false), Unchecked);
         let table = ladder_table(&[point(Some(true), Some(false), false)]);
         assert!(table.contains("| steady, **unbalanced** |"), "{table}");
-    }
-
-    #[test]
-    fn the_note_counts_each_reason_a_point_is_hollow() {
-        let points = [
-            point(Some(true), Some(true), false),
-            point(Some(true), Some(false), false),
-            point(Some(false), None, false),
-            point(Some(true), Some(true), true),
-        ];
-        let notes = ladder_notes(&points);
-        assert_eq!(notes.len(), 1, "{notes:?}");
-        assert!(
-            notes[0].starts_with("Hollow markers: 3 of 4 cells")
-                && notes[0].contains("1 still running, 1 not steady, 1 steady, not balanced"),
-            "{notes:?}"
-        );
-        assert!(ladder_notes(&points[..1]).is_empty());
     }
 
     #[test]

@@ -170,12 +170,19 @@ impl CellResult {
         self.angle_deg == other.angle_deg && self.shape == other.shape && self.swept == other.swept
     }
 
-    /// Whether the cell's erosion is a stationary rate (docs/erosion.md, *The damage
-    /// balance*): at steady state and, where the records carry damage, with its loss paying for
-    /// the damage its impacts add by the current rule; `None` where steadiness was not checked.
+    /// Whether the cell's erosion is a stationary rate by the current rules, and if not, why
+    /// (docs/erosion.md, *The damage balance*).
+    pub fn stationarity(&self) -> Stationarity {
+        Stationarity::of(
+            self.steady_state.as_ref().map(|s| s.steady),
+            self.damage_balance.as_ref().map(DamageBalance::holds),
+        )
+    }
+
+    /// Whether the cell's erosion is a stationary rate ([`Stationarity::is_rate`]); `None`
+    /// where steadiness was not checked.
     pub fn stationary(&self) -> Option<bool> {
-        let steady = self.steady_state.as_ref()?.steady;
-        Some(steady && self.damage_balance.is_none_or(|b| b.holds()))
+        self.stationarity().is_rate()
     }
 
     /// The cell's name in messages: angle, shape and any other swept values.
@@ -185,6 +192,54 @@ impl CellResult {
             label.push_str(&format!(" {name}={value}"));
         }
         label
+    }
+}
+
+/// Whether a cell's erosion is a stationary rate (docs/erosion.md, *The damage balance*): at
+/// steady state and, where the records carry damage, with its loss paying for the damage its
+/// impacts add; otherwise the first rule it fails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stationarity {
+    /// Steady and, where there is a balance, balanced: a stationary rate.
+    Rate,
+    /// Samples or impacts still missing against the plan (a campaign still running).
+    Running,
+    /// The steady-state check fails.
+    Unsteady,
+    /// Steady, but the last window's loss does not pay for the damage added.
+    Unbalanced,
+    /// Written before the steady-state check existed: nothing to judge it by.
+    Unchecked,
+}
+
+impl Stationarity {
+    /// The verdict from the steady check and the damage balance, each `None` where the file has
+    /// none; a missing balance does not count against the cell.
+    pub fn of(steady: Option<bool>, balanced: Option<bool>) -> Self {
+        match (steady, balanced) {
+            (None, _) => Self::Unchecked,
+            (Some(false), _) => Self::Unsteady,
+            (Some(true), Some(false)) => Self::Unbalanced,
+            (Some(true), _) => Self::Rate,
+        }
+    }
+
+    /// `Running` in place of any verdict for a cell that is still missing samples or impacts.
+    pub fn unless_partial(self, partial: bool) -> Self {
+        if partial {
+            Self::Running
+        } else {
+            self
+        }
+    }
+
+    /// Whether this is a stationary rate; `None` where it was never checked.
+    pub fn is_rate(self) -> Option<bool> {
+        match self {
+            Self::Rate => Some(true),
+            Self::Unchecked => None,
+            _ => Some(false),
+        }
     }
 }
 
