@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use crate::impact::aggregate::{CampaignResults, CellResult};
+use crate::impact::balance::LONG_BALANCE_POINTS;
 use crate::models::oka::{
     oka_g, oka_silica_exponents, shape_modification, ShapeExponents, ShapeReference, AISI304_HV_GPA,
 };
@@ -170,6 +171,17 @@ pub struct RepeatRow {
     /// (seed section 3.1; the target in docs/design.md is 10 % and 1.5 combined s.e.).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ratio_vs_first: Option<f64>,
+    /// Loss over each sample's last 60 impacts per grain mass (`long_balance`): a balanced
+    /// cell's rate without the selection of the window that stopped it; absent where the file
+    /// has no such balance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub long_loss: Option<f64>,
+    /// Standard error of `long_loss`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub long_loss_sem: Option<f64>,
+    /// long_loss / the first file's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub long_ratio_vs_first: Option<f64>,
 }
 
 /// A cell (shape, angle and swept values) found in two or more results files: the same cell
@@ -242,6 +254,7 @@ pub fn on_window(
         c.erosion_sem_rel = None;
         c.steady_state = None;
         c.damage_balance = None;
+        c.long_balance = None;
     }
     out.steady = None;
     Ok((out, notes))
@@ -287,6 +300,14 @@ pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell>
                         },
                         ratio_vs_first: match (c.erosion_mean, same.erosion_mean) {
                             (Some(a), Some(b)) if a > 0.0 => Some(b / a),
+                            _ => None,
+                        },
+                        long_loss: same.long_balance.map(|b| b.loss_rate),
+                        long_loss_sem: same.long_balance.map(|b| b.loss_rate_sem),
+                        long_ratio_vs_first: match (c.long_balance, same.long_balance) {
+                            (Some(a), Some(b)) if a.loss_rate > 0.0 => {
+                                Some(b.loss_rate / a.loss_rate)
+                            }
                             _ => None,
                         },
                     })
@@ -626,10 +647,11 @@ pub fn markdown(c: &Comparison) -> String {
             }),
         );
     }
+    let long = format!("loss, last {LONG_BALANCE_POINTS} (mg/g) ± s.e.");
     for r in &c.repeated {
         let _ = writeln!(
             s,
-            "\n{} at {}° in {} files (ratio: erosion over the first file's; z: their difference over both standard errors):\n",
+            "\n{} at {}° in {} files (ratio: erosion over the first file's; z: their difference over both standard errors; last {LONG_BALANCE_POINTS}: loss per grain mass over each sample's last {LONG_BALANCE_POINTS} impacts, free of the selection of the window that stopped a balanced cell):\n",
             r.shape,
             r.angle_deg,
             r.rows.len()
@@ -644,6 +666,8 @@ pub fn markdown(c: &Comparison) -> String {
                 "ratio to the first",
                 "z against the first",
                 "cell",
+                &long,
+                "its ratio to the first",
             ],
             r.rows.iter().map(|w| {
                 vec![
@@ -658,6 +682,12 @@ pub fn markdown(c: &Comparison) -> String {
                     num(w.ratio_vs_first, 2),
                     num(w.z_vs_first, 1),
                     verdict(w.steady, w.balanced, w.partial),
+                    format!(
+                        "{} ± {}",
+                        num(w.long_loss.map(|e| 1e3 * e), 2),
+                        num(w.long_loss_sem.map(|e| 1e3 * e), 2)
+                    ),
+                    num(w.long_ratio_vs_first, 2),
                 ]
             }),
         );
@@ -877,16 +907,27 @@ mod tests {
     fn a_cell_in_several_files_is_set_beside_the_first_with_its_resolution() {
         let spec =
             |dx: f64| serde_json::json!({"spacing_m": [dx], "grain": {"diameter_m": 250e-6}});
-        let coarse = results(vec![
-            cell("hexagon", 45.0, 3e-3, 0.3e-3, true),
-            cell("hexagon", 90.0, 2e-3, 0.2e-3, true),
-        ])
-        .with_spec(spec(250e-6 / 16.0));
-        let fine = results(vec![
-            cell("hexagon", 45.0, 3.5e-3, 0.4e-3, false),
-            cell("hexagon", 15.0, 1e-3, 0.1e-3, true),
-        ])
-        .with_spec(spec(250e-6 / 24.0));
+        // Both 45° cells carry their loss over the last 60 impacts.
+        let long = |loss_rate: f64| crate::impact::balance::DamageBalance {
+            points: LONG_BALANCE_POINTS,
+            samples: 10,
+            loss_rate,
+            loss_rate_sem: 0.1e-3,
+            damage_rate: loss_rate,
+            damage_rate_sem: 0.1e-3,
+            difference_sem: 0.1e-3,
+            ratio: Some(1.0),
+            balanced: true,
+            detectable_rel: Some(0.1),
+        };
+        let mut coarse45 = cell("hexagon", 45.0, 3e-3, 0.3e-3, true);
+        coarse45.long_balance = Some(long(2.75e-3));
+        let coarse = results(vec![coarse45, cell("hexagon", 90.0, 2e-3, 0.2e-3, true)])
+            .with_spec(spec(250e-6 / 16.0));
+        let mut fine45 = cell("hexagon", 45.0, 3.5e-3, 0.4e-3, false);
+        fine45.long_balance = Some(long(3.3e-3));
+        let fine = results(vec![fine45, cell("hexagon", 15.0, 1e-3, 0.1e-3, true)])
+            .with_spec(spec(250e-6 / 24.0));
         let files = [
             ("a.json".to_string(), &coarse),
             ("b.json".to_string(), &fine),
@@ -909,9 +950,12 @@ mod tests {
         c.repeated = rep;
         let md = markdown(&c);
         assert!(
-            md.contains("| b.json | 24.0 | 10 | 3.50 ± 0.40 | 1.17 | 1.0 | **unsteady** |"),
+            md.contains(
+                "| b.json | 24.0 | 10 | 3.50 ± 0.40 | 1.17 | 1.0 | **unsteady** | 3.30 ± 0.10 | 1.20 |"
+            ),
             "{md}"
         );
+        assert!(md.contains("| loss, last 60 (mg/g) ± s.e. | its ratio to the first |"));
     }
 
     #[test]

@@ -161,6 +161,11 @@ pub struct CellResult {
     /// where the records carry no damage.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub damage_balance: Option<DamageBalance>,
+    /// The same over each sample's last [`balance::LONG_BALANCE_POINTS`] impacts
+    /// ([`balance::assess_long`]): what a balanced cell's loss is without the selection of the
+    /// window that stopped it; absent below that many impacts or where there is no damage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub long_balance: Option<DamageBalance>,
 }
 
 impl CellResult {
@@ -481,6 +486,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         .collect();
 
     let damage_balance = balance::assess(&samples);
+    let long_balance = balance::assess_long(&samples);
     let steady_state = steady::assess(&series, &mean_series);
     let summary = stats(&slopes);
     let partial = samples.len() < cell.planned_samples
@@ -504,6 +510,7 @@ pub fn aggregate_cell(cell: &CellInput, window: usize) -> Result<CellResult, Agg
         convergence: convergence(&slopes),
         steady_state: Some(steady_state),
         damage_balance,
+        long_balance,
     })
 }
 
