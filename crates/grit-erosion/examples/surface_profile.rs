@@ -6,7 +6,10 @@
 //! floor's depth below the lips is what a worn surface's impact flies through step by step
 //! (docs/performance.md, *The flight over a crater*).
 //!
-//! `--columns` prints every column's top instead. `--incidence` sweeps the seed's grains
+//! `--columns` prints every column's top instead. `--stock` splits the damage stock Σ m D of
+//! the free particles by each particle's distance below the surface (to the nearest column top)
+//! and by whether it lies under the aim band, beside the length of the surface line: where a
+//! worn surface keeps the damage its impacts added and have not yet removed. `--incidence` sweeps the seed's grains
 //! (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
@@ -38,6 +41,7 @@ enum Mode {
     Columns,
     Incidence,
     Grains,
+    Stock,
 }
 
 /// A fired grain to place on a checkpoint's surface: its impact number, orientation, aim.
@@ -49,7 +53,7 @@ struct Fired {
 
 fn usage() -> ! {
     eprintln!(
-        "usage: surface_profile [--columns | --incidence] CHECKPOINT… | --grains FILE | --run …"
+        "usage: surface_profile [--columns | --incidence | --stock] CHECKPOINT… | --grains FILE | --run …"
     );
     std::process::exit(2);
 }
@@ -60,6 +64,7 @@ fn main() {
         Some("--columns") => Mode::Columns,
         Some("--incidence") => Mode::Incidence,
         Some("--grains") => Mode::Grains,
+        Some("--stock") => Mode::Stock,
         Some("--run") => return run(&args[1..]),
         _ => Mode::Summary,
     };
@@ -102,6 +107,7 @@ fn main() {
                 "checkpoint\timpacts\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg",
             Mode::Grains =>
                 "checkpoint\tunit\timpacts\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg",
+            Mode::Stock => STOCK_HEADER,
         }
     );
     for (path, fired) in &work {
@@ -144,6 +150,7 @@ fn main() {
                     }
                 }
             }
+            Mode::Stock => println!("{path}\t{done}\t{}\t{}", p.angle_deg, stock_row(&s, &tops)),
             Mode::Summary => {
                 let lips = tops.iter().map(|t| t.y).fold(f64::NEG_INFINITY, f64::max);
                 // The aim band's columns: centres within half the distribution range of the middle.
@@ -165,6 +172,69 @@ fn main() {
             }
         }
     }
+}
+
+/// Upper edges of the depth bins of `--stock`, in Dg below the surface; the last bin is open.
+const STOCK_DEPTHS_DG: [f64; 4] = [0.05, 0.1, 0.2, 0.4];
+
+const STOCK_HEADER: &str = "checkpoint\timpacts\tangle_deg\tline_dg\tband_line_dg\tstock\t\
+    band_stock\td<0.05\td<0.1\td<0.2\td<0.4\td>=0.4\tstock_per_line_dg";
+
+/// `--stock`'s columns after the angle: the surface line's length over the box and over the aim
+/// band (Dg); the damage stock, all and under the band, then per depth bin, in mg per g of one
+/// grain; the stock per Dg of surface line.
+fn stock_row(s: &Sample, tops: &[Vector]) -> String {
+    let p = s.params();
+    let dg = p.grain_diameter_m;
+    let per_grain = 1e3 / p.grain_mass_kg_m();
+    let reach = 0.5 * p.distribution_range_dg * dg;
+    let (mut line, mut band_line) = (0.0, 0.0);
+    for w in tops.windows(2) {
+        let l = (w[1] - w[0]).norm();
+        line += l;
+        if 0.5 * (w[0].x + w[1].x).abs() <= reach {
+            band_line += l;
+        }
+    }
+    let surface = s.surface();
+    let (mut stock, mut band_stock) = (0.0, 0.0);
+    let mut by_depth = [0.0; STOCK_DEPTHS_DG.len() + 1];
+    for i in 0..surface.len() {
+        if surface.flags[i] & KINEMATIC != 0 {
+            continue;
+        }
+        let md = surface.mass[i] * surface.damage[i];
+        if md == 0.0 {
+            continue;
+        }
+        let x = surface.pos[i];
+        let depth = tops
+            .iter()
+            .map(|t| (t - x).norm())
+            .fold(f64::INFINITY, f64::min)
+            / dg;
+        let bin = STOCK_DEPTHS_DG
+            .iter()
+            .position(|&edge| depth < edge)
+            .unwrap_or(STOCK_DEPTHS_DG.len());
+        by_depth[bin] += md;
+        stock += md;
+        if x.x.abs() <= reach {
+            band_stock += md;
+        }
+    }
+    let mut row = format!(
+        "{:.3}\t{:.3}\t{:.1}\t{:.1}",
+        line / dg,
+        band_line / dg,
+        stock * per_grain,
+        band_stock * per_grain
+    );
+    for b in by_depth {
+        row.push_str(&format!("\t{:.1}", b * per_grain));
+    }
+    row.push_str(&format!("\t{:.1}", stock * per_grain * dg / line));
+    row
 }
 
 /// The free surface's highest point per column one Δx wide, as (column centre, top) points;
