@@ -502,6 +502,16 @@ fn num(v: Option<f64>, digits: usize) -> String {
     v.map_or("–".into(), |v| format!("{v:.digits$}"))
 }
 
+/// `value ± s.e.` times `scale` to two decimals; "–" without a value, the value alone without
+/// an error.
+fn pm(v: Option<f64>, sem: Option<f64>, scale: f64) -> String {
+    match (v, sem) {
+        (None, _) => "–".into(),
+        (Some(v), None) => format!("{:.2}", scale * v),
+        (Some(v), Some(e)) => format!("{:.2} ± {:.2}", scale * v, scale * e),
+    }
+}
+
 fn yes_no(v: Option<bool>, yes: &str, no: &str) -> String {
     v.map_or("not checked".into(), |b| (if b { yes } else { no }).into())
 }
@@ -523,7 +533,7 @@ pub fn verdict(steady: Option<bool>, balanced: Option<bool>, partial: bool) -> S
 /// A ratio's table cells: value ± s.e., reference, deviation, z, goal and steadiness.
 fn ratio_cells(r: &Ratio) -> [String; 6] {
     [
-        format!("{} ± {}", num(r.value, 2), num(r.sem, 2)),
+        pm(r.value, r.sem, 1.0),
         format!("{:.2}", r.reference),
         r.deviation
             .map_or("–".into(), |d| format!("{:+.0} %", 100.0 * d)),
@@ -570,11 +580,7 @@ pub fn markdown(c: &Comparison) -> String {
             let mut row = vec![
                 a.shape.clone(),
                 format!("{}°", a.angle_deg),
-                format!(
-                    "{} ± {}",
-                    num(a.erosion.map(|e| 1e3 * e), 2),
-                    num(a.erosion_sem.map(|e| 1e3 * e), 2)
-                ),
+                pm(a.erosion, a.erosion_sem, 1e3),
             ];
             row.extend(ratio_cells(&a.ratio));
             row
@@ -674,19 +680,11 @@ pub fn markdown(c: &Comparison) -> String {
                     w.file.clone(),
                     num(w.particles_per_dg, 1),
                     w.samples.to_string(),
-                    format!(
-                        "{} ± {}",
-                        num(w.erosion.map(|e| 1e3 * e), 2),
-                        num(w.erosion_sem.map(|e| 1e3 * e), 2)
-                    ),
+                    pm(w.erosion, w.erosion_sem, 1e3),
                     num(w.ratio_vs_first, 2),
                     num(w.z_vs_first, 1),
                     verdict(w.steady, w.balanced, w.partial),
-                    format!(
-                        "{} ± {}",
-                        num(w.long_loss.map(|e| 1e3 * e), 2),
-                        num(w.long_loss_sem.map(|e| 1e3 * e), 2)
-                    ),
+                    pm(w.long_loss, w.long_loss_sem, 1e3),
                     num(w.long_ratio_vs_first, 2),
                 ]
             }),
