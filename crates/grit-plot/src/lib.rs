@@ -30,7 +30,7 @@ mod sweep;
 
 use std::path::{Path, PathBuf};
 
-use grit_erosion::CampaignResults;
+use grit_erosion::{CampaignResults, Stationarity};
 
 pub use draw::colour;
 pub use fit::plot_fit;
@@ -132,9 +132,9 @@ pub fn summary_table(results: &CampaignResults) -> String {
             fmt(c.erosion_mean),
             fmt(c.erosion_std),
             if c.partial { "  (partial)" } else { "" },
-            match (&c.steady_state, c.stationary()) {
-                (Some(s), _) if !s.steady => "  (not at steady state)",
-                (_, Some(false)) => "  (steady, not balanced)",
+            match c.stationarity() {
+                Stationarity::Unsteady => "  (not at steady state)",
+                Stationarity::Unbalanced => "  (steady, not balanced)",
                 _ => "",
             }
         ));
