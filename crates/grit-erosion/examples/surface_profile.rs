@@ -9,8 +9,8 @@
 //! `--columns` prints every column's top instead. `--stock` splits the damage stock Σ m D of
 //! the free particles by each particle's distance below the surface (to the nearest column top)
 //! and by whether it lies under the aim band, beside the length of the surface line: where a
-//! worn surface keeps the damage its impacts added and have not yet removed. `--incidence` sweeps the seed's grains
-//! (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
+//! worn surface keeps the damage its impacts added and have not yet removed.
+//! `--incidence` sweeps the seed's grains (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
 //! trench's local incidence strays from the nominal angle. `--grains FILE` does the same for

@@ -3,13 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
+use grit_erosion::Stationarity;
 use plotters::chart::MeshStyle;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-
-use grit_erosion::Stationarity;
 
 use crate::PlotError;
 

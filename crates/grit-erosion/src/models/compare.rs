@@ -298,18 +298,13 @@ pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell>
                             },
                             _ => None,
                         },
-                        ratio_vs_first: match (c.erosion_mean, same.erosion_mean) {
-                            (Some(a), Some(b)) if a > 0.0 => Some(b / a),
-                            _ => None,
-                        },
+                        ratio_vs_first: ratio_to(same.erosion_mean, c.erosion_mean),
                         long_loss: same.long_balance.map(|b| b.loss_rate),
                         long_loss_sem: same.long_balance.map(|b| b.loss_rate_sem),
-                        long_ratio_vs_first: match (c.long_balance, same.long_balance) {
-                            (Some(a), Some(b)) if a.loss_rate > 0.0 => {
-                                Some(b.loss_rate / a.loss_rate)
-                            }
-                            _ => None,
-                        },
+                        long_ratio_vs_first: ratio_to(
+                            same.long_balance.map(|b| b.loss_rate),
+                            c.long_balance.map(|b| b.loss_rate),
+                        ),
                     })
                 })
                 .collect();
@@ -323,6 +318,14 @@ pub fn repeated_cells(files: &[(String, &CampaignResults)]) -> Vec<RepeatedCell>
         }
     }
     out
+}
+
+/// `value / first`, where both are known and `first` is positive.
+fn ratio_to(value: Option<f64>, first: Option<f64>) -> Option<f64> {
+    match (value, first) {
+        (Some(v), Some(f)) if f > 0.0 => Some(v / f),
+        _ => None,
+    }
 }
 
 fn cell<'a>(r: &'a CampaignResults, shape: &str, angle: f64) -> Option<&'a CellResult> {

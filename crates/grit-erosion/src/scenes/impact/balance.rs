@@ -317,8 +317,8 @@ mod tests {
 
     #[test]
     fn the_long_balance_spans_the_last_sixty_impacts_of_the_samples_that_have_them() {
-        // The loss is 6 mg/g in impacts 41–60 and 3 before, against 4 added throughout: the
-        // last window shows 6, the last 60 the mean of 3, 3 and 6.
+        // The loss is 6 mg/g in impacts 61–80 and 3 before, against 4 added throughout: the
+        // last window shows 6, the last 60 (21–80) the mean of 3, 3 and 6.
         let mut s: Vec<SampleInput> = (0..3).map(|k| sample(k, 80, 0.0, Some(4e-3))).collect();
         for (k, x) in s.iter_mut().enumerate() {
             let n = x.impacts.len();
