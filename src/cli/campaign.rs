@@ -330,27 +330,41 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// An impact cell's line: the seed's erosion (section 4, last-20 slope) and the damage
+/// balance (docs/erosion.md): mean ± std over samples, the last window's loss/damage added, and the loss over
+/// the last 60 impacts with its standard error.
+fn impact_cell_line(c: &grit_erosion::CellResult) -> String {
+    let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
+    // Below 1 while the surface still stores more damage than it loses.
+    let paid = c
+        .damage_balance
+        .and_then(|b| b.ratio)
+        .map_or(String::new(), |q| format!("  loss/damage added {q:.2}"));
+    // The last window's slope swings with the cell's fluctuations; the last 60 impacts' loss
+    // is the steadier figure beside it.
+    let long = c.long_balance.map_or(String::new(), |b| {
+        format!(
+            "  last {} loss {:.4e} (s.e. {:.1e})",
+            b.points, b.loss_rate, b.loss_rate_sem
+        )
+    });
+    format!(
+        "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}{paid}{long}",
+        c.angle_deg,
+        c.shape,
+        c.samples,
+        fmt(c.erosion_mean),
+        fmt(c.erosion_std)
+    )
+}
+
 /// One line per cell of the results on stdout: erosion for impacts, Cd, Cw and mass loss at T
 /// for a jet.
 fn say_cells(results: &AnyResults) {
-    let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
     match results {
         AnyResults::Impact(r) => {
             for c in &r.results.cells {
-                // Below 1 while the surface still stores more damage than it loses
-                // (docs/erosion.md, "The damage balance").
-                let paid = c
-                    .damage_balance
-                    .and_then(|b| b.ratio)
-                    .map_or(String::new(), |q| format!("  loss/damage added {q:.2}"));
-                say!(
-                    "{:>6.1}°  {:<10} samples {:>3}  erosion {} ± {}{paid}",
-                    c.angle_deg,
-                    c.shape,
-                    c.samples,
-                    fmt(c.erosion_mean),
-                    fmt(c.erosion_std)
-                );
+                say!("{}", impact_cell_line(c));
             }
         }
         AnyResults::Jet(r) => {
@@ -675,4 +689,44 @@ pub async fn retry_failed(a: IdArgs) -> anyhow::Result<ExitCode> {
     let r = a.remote.client()?.retry_failed(id).await?;
     say!("{id}: {} failed jobs queued again", r.jobs);
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::impact_cell_line;
+
+    fn cell(balances: bool) -> grit_erosion::CellResult {
+        let balance = |points: usize, loss: f64, damage: f64| {
+            serde_json::json!({
+                "points": points, "samples": 25, "loss_rate": loss, "loss_rate_sem": 7e-5,
+                "damage_rate": damage, "damage_rate_sem": 6e-5, "difference_sem": 1e-4,
+                "ratio": loss / damage, "balanced": false, "detectable_rel": 0.05,
+            })
+        };
+        let mut json = serde_json::json!({
+            "angle_deg": 45.0, "shape": "hexagon", "partial": false, "samples": 25,
+            "samples_planned": 25, "samples_reported": 25, "samples_without_slope": 0,
+            "impacts_planned": 420, "erosion_mean": 4.1385e-3, "erosion_std": 9.5548e-4,
+            "erosion_sem": 1.9e-4, "per_sample": [], "mean_series": [], "convergence": [],
+        });
+        if balances {
+            json["damage_balance"] = balance(20, 4.0e-3, 5.0e-3);
+            json["long_balance"] = balance(60, 3.9006e-3, 4.2e-3);
+        }
+        serde_json::from_value(json).unwrap()
+    }
+
+    #[test]
+    fn a_cells_line_gives_the_last_60_impacts_loss_beside_the_last_window() {
+        assert_eq!(
+            impact_cell_line(&cell(true)),
+            "  45.0°  hexagon    samples  25  erosion 4.1385e-3 ± 9.5548e-4  \
+             loss/damage added 0.80  last 60 loss 3.9006e-3 (s.e. 7.0e-5)"
+        );
+        // Records without the damage (older files) leave both figures out, not zeros.
+        assert_eq!(
+            impact_cell_line(&cell(false)),
+            "  45.0°  hexagon    samples  25  erosion 4.1385e-3 ± 9.5548e-4"
+        );
+    }
 }
