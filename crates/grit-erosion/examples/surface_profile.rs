@@ -9,7 +9,9 @@
 //! `--columns` prints every column's top instead. `--stock` splits the damage stock Σ m D of
 //! the free particles by each particle's distance below the surface (to the nearest column top)
 //! and by whether it lies under the aim band, beside the length of the surface line: where a
-//! worn surface keeps the damage its impacts added and have not yet removed.
+//! worn surface keeps the damage its impacts added and have not yet removed. `--walls` gives
+//! the stock within 0.1, 0.25 and 0.5 Dg of the box's fixed bottom and sides: whether the
+//! damage reaches the edges the box holds fixed.
 //! `--incidence` sweeps the seed's grains (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
@@ -22,7 +24,7 @@
 //! every impact, where its grain first touched the surface just before it and at what local
 //! angle, with its damage added and loss (OUT-impacts.tsv), and every 20 impacts each sample's
 //! column tops (OUT-columns.tsv).
-//! Usage: `surface_profile [--columns | --incidence] CHECKPOINT…`,
+//! Usage: `surface_profile [--columns | --incidence | --stock | --walls] CHECKPOINT…`,
 //! `surface_profile --grains FILE` or `surface_profile --run …`.
 use grit_erosion::impact::{GrainStart, ImpactParams};
 use grit_erosion::{Sample, Shape};
@@ -42,6 +44,7 @@ enum Mode {
     Incidence,
     Grains,
     Stock,
+    Walls,
 }
 
 /// A fired grain to place on a checkpoint's surface: its impact number, orientation, aim.
@@ -53,7 +56,7 @@ struct Fired {
 
 fn usage() -> ! {
     eprintln!(
-        "usage: surface_profile [--columns | --incidence | --stock] CHECKPOINT… | --grains FILE | --run …"
+        "usage: surface_profile [--columns | --incidence | --stock | --walls] CHECKPOINT… | --grains FILE | --run …"
     );
     std::process::exit(2);
 }
@@ -65,6 +68,7 @@ fn main() {
         Some("--incidence") => Mode::Incidence,
         Some("--grains") => Mode::Grains,
         Some("--stock") => Mode::Stock,
+        Some("--walls") => Mode::Walls,
         Some("--run") => return run(&args[1..]),
         _ => Mode::Summary,
     };
@@ -108,6 +112,7 @@ fn main() {
             Mode::Grains =>
                 "checkpoint\tunit\timpacts\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg",
             Mode::Stock => STOCK_HEADER,
+            Mode::Walls => WALLS_HEADER,
         }
     );
     for (path, fired) in &work {
@@ -151,6 +156,7 @@ fn main() {
                 }
             }
             Mode::Stock => println!("{path}\t{done}\t{}\t{}", p.angle_deg, stock_row(&s, &tops)),
+            Mode::Walls => println!("{path}\t{done}\t{}\t{}", p.angle_deg, walls_row(&s, &tops)),
             Mode::Summary => {
                 let lips = tops.iter().map(|t| t.y).fold(f64::NEG_INFINITY, f64::max);
                 // The aim band's columns: centres within half the distribution range of the middle.
@@ -208,11 +214,7 @@ fn stock_row(s: &Sample, tops: &[Vector]) -> String {
             continue;
         }
         let x = surface.pos[i];
-        let depth = tops
-            .iter()
-            .map(|t| (t - x).norm())
-            .fold(f64::INFINITY, f64::min)
-            / dg;
+        let depth = depth_below(tops, x) / dg;
         let bin = STOCK_DEPTHS_DG
             .iter()
             .position(|&edge| depth < edge)
@@ -235,6 +237,86 @@ fn stock_row(s: &Sample, tops: &[Vector]) -> String {
     }
     row.push_str(&format!("\t{:.1}", stock * per_grain * dg / line));
     row
+}
+
+/// Upper edges of the distance bins of `--walls`, in Dg from the box's fixed bottom or sides.
+const WALL_DISTANCES_DG: [f64; 3] = [0.1, 0.25, 0.5];
+
+const WALLS_HEADER: &str = "checkpoint\timpacts\tangle_deg\tfloor_above_bottom_dg\tstock\t\
+    bottom<0.1\tbottom<0.25\tbottom<0.5\tsides<0.1\tsides<0.25\tsides<0.5\t\
+    sides<0.5_d<0.2\tleft<0.5\tright<0.5\tedges<0.5";
+
+/// `--walls`' columns after the angle: the aim band's lowest column top above the box's bottom
+/// (Dg); the damage stock, all, then within each distance of the fixed bottom and of the fixed
+/// sides (cumulative), of the last within 0.2 Dg of the surface, and within 0.5 Dg of the
+/// left (−x, where a grain at an angle comes from) and the right side, and within 0.5 Dg of
+/// any fixed edge (bottom or side; the rest is the interior), in mg per g of one grain:
+/// whether the damage reaches the box's edges, and whether it lies deep along them.
+fn walls_row(s: &Sample, tops: &[Vector]) -> String {
+    let p = s.params();
+    let dg = p.grain_diameter_m;
+    let per_grain = 1e3 / p.grain_mass_kg_m();
+    let reach = 0.5 * p.distribution_range_dg * dg;
+    let surface = s.surface();
+    let free = || (0..surface.len()).filter(|&i| surface.flags[i] & KINEMATIC == 0);
+    let bottom = free()
+        .map(|i| surface.pos[i].y)
+        .fold(f64::INFINITY, f64::min);
+    let left = free()
+        .map(|i| surface.pos[i].x)
+        .fold(f64::INFINITY, f64::min);
+    let right = free()
+        .map(|i| surface.pos[i].x)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let floor = tops
+        .iter()
+        .filter(|t| t.x.abs() <= reach)
+        .map(|t| t.y)
+        .fold(f64::INFINITY, f64::min);
+    let (mut stock, mut sides_shallow, mut left_side, mut right_side) = (0.0, 0.0, 0.0, 0.0);
+    let mut edges = 0.0;
+    let (mut near_bottom, mut near_sides) = ([0.0; 3], [0.0; 3]);
+    for i in free() {
+        let md = surface.mass[i] * surface.damage[i];
+        let x = surface.pos[i];
+        stock += md;
+        let up = (x.y - bottom) / dg;
+        let side = (x.x - left).min(right - x.x) / dg;
+        for (k, &edge) in WALL_DISTANCES_DG.iter().enumerate() {
+            if up < edge {
+                near_bottom[k] += md;
+            }
+            if side < edge {
+                near_sides[k] += md;
+            }
+        }
+        if side < WALL_DISTANCES_DG[2] && md > 0.0 && depth_below(tops, x) < 0.2 * dg {
+            sides_shallow += md;
+        }
+        if up.min(side) < WALL_DISTANCES_DG[2] {
+            edges += md;
+        }
+        if (x.x - left) / dg < WALL_DISTANCES_DG[2] {
+            left_side += md;
+        } else if (right - x.x) / dg < WALL_DISTANCES_DG[2] {
+            right_side += md;
+        }
+    }
+    let mut row = format!("{:.3}\t{:.1}", (floor - bottom) / dg, stock * per_grain);
+    for b in near_bottom.iter().chain(&near_sides) {
+        row.push_str(&format!("\t{:.2}", b * per_grain));
+    }
+    for b in [sides_shallow, left_side, right_side, edges] {
+        row.push_str(&format!("\t{:.2}", b * per_grain));
+    }
+    row
+}
+
+/// Distance from `x` to the nearest column top: its depth below the worn surface.
+fn depth_below(tops: &[Vector], x: Vector) -> f64 {
+    tops.iter()
+        .map(|t| (t - x).norm())
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The free surface's highest point per column one Δx wide, as (column centre, top) points;

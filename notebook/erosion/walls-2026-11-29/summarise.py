@@ -1,0 +1,57 @@
+"""Damage stock by region of the box, and its growth per impact, from `surface_profile --walls`.
+
+usage: summarise.py WALLS.tsv CAMPAIGN CELL LO HI
+Takes the checkpoints of CAMPAIGN's CELL (paths .../CAMPAIGN/cCELL-SAMPLE-IMPACTS.ckpt) at LO and
+HI impacts, pairs them by sample, and prints each region's stock at HI and its growth per impact
+over LO..HI (mean ± standard error over samples; mg per g of one grain).
+"""
+import math
+import sys
+
+path, campaign, cell, lo, hi = sys.argv[1:6]
+lo, hi = int(lo), int(hi)
+rows = [line.rstrip("\n").split("\t") for line in open(path)]
+head, rows = rows[0], rows[1:]
+col = {name: i for i, name in enumerate(head)}
+
+
+def regions(r):
+    v = {k: float(r[col[k]]) for k in head[4:]}
+    return {
+        "all": v["stock"],
+        "interior": v["stock"] - v["edges<0.5"],
+        "edges (≤0.5 Dg)": v["edges<0.5"],
+        "upstream side (≤0.5)": v["left<0.5"],
+        "downstream side (≤0.5)": v["right<0.5"],
+        "bottom (≤0.5)": v["bottom<0.5"],
+        "at the walls (≤0.1)": v["sides<0.1"] + v["bottom<0.1"],
+    }
+
+
+by = {}
+for r in rows:
+    parts = r[0].split("/")
+    if len(parts) < 2 or parts[-2] != campaign:
+        continue
+    c, s, n = parts[-1][1:].removesuffix(".ckpt").split("-")
+    if c == cell and int(n) in (lo, hi):
+        by.setdefault(int(s), {})[int(n)] = regions(r)
+pairs = [v for v in by.values() if lo in v and hi in v]
+if not pairs:
+    sys.exit(f"no sample of {campaign} cell {cell} has checkpoints at both {lo} and {hi}")
+
+
+def mean_se(xs):
+    m = sum(xs) / len(xs)
+    if len(xs) < 2:
+        return m, float("nan")
+    return m, math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1) / len(xs))
+
+
+print(f"{campaign} cell {cell}, impacts {lo}-{hi}, {len(pairs)} samples")
+print("| region | stock at %d | growth per impact |" % hi)
+print("|---|---|---|")
+for k in pairs[0][hi]:
+    level = mean_se([p[hi][k] for p in pairs])
+    grow = mean_se([(p[hi][k] - p[lo][k]) / (hi - lo) for p in pairs])
+    print(f"| {k} | {level[0]:.0f} ± {level[1]:.0f} | {grow[0]:+.2f} ± {grow[1]:.2f} |")
