@@ -11,7 +11,8 @@
 //! and by whether it lies under the aim band, beside the length of the surface line: where a
 //! worn surface keeps the damage its impacts added and have not yet removed. `--walls` gives
 //! the stock within 0.1, 0.25 and 0.5 Dg of the box's fixed bottom and sides: whether the
-//! damage reaches the edges the box holds fixed.
+//! damage reaches the edges the box holds fixed. `--across` gives the stock in strips 0.25 Dg
+//! wide across the box.
 //! `--incidence` sweeps the seed's grains (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
@@ -24,7 +25,7 @@
 //! every impact, where its grain first touched the surface just before it and at what local
 //! angle, with its damage added and loss (OUT-impacts.tsv), and every 20 impacts each sample's
 //! column tops (OUT-columns.tsv).
-//! Usage: `surface_profile [--columns | --incidence | --stock | --walls] CHECKPOINT…`,
+//! Usage: `surface_profile [--columns | --incidence | --stock | --walls | --across] CHECKPOINT…`,
 //! `surface_profile --grains FILE` or `surface_profile --run …`.
 use grit_erosion::impact::{GrainStart, ImpactParams};
 use grit_erosion::{Sample, Shape};
@@ -45,6 +46,7 @@ enum Mode {
     Grains,
     Stock,
     Walls,
+    Across,
 }
 
 /// A fired grain to place on a checkpoint's surface: its impact number, orientation, aim.
@@ -56,7 +58,7 @@ struct Fired {
 
 fn usage() -> ! {
     eprintln!(
-        "usage: surface_profile [--columns | --incidence | --stock | --walls] CHECKPOINT… | --grains FILE | --run …"
+        "usage: surface_profile [--columns | --incidence | --stock | --walls | --across] CHECKPOINT… | --grains FILE | --run …"
     );
     std::process::exit(2);
 }
@@ -69,6 +71,7 @@ fn main() {
         Some("--grains") => Mode::Grains,
         Some("--stock") => Mode::Stock,
         Some("--walls") => Mode::Walls,
+        Some("--across") => Mode::Across,
         Some("--run") => return run(&args[1..]),
         _ => Mode::Summary,
     };
@@ -113,6 +116,7 @@ fn main() {
                 "checkpoint\tunit\timpacts\tangle_deg\taim_dg\tcontact_x_dg\tcontact_y_dg\tlocal_deg",
             Mode::Stock => STOCK_HEADER,
             Mode::Walls => WALLS_HEADER,
+            Mode::Across => "checkpoint\timpacts\tangle_deg\tx_from_dg\tx_to_dg\tstock",
         }
     );
     for (path, fired) in &work {
@@ -157,6 +161,14 @@ fn main() {
             }
             Mode::Stock => println!("{path}\t{done}\t{}\t{}", p.angle_deg, stock_row(&s, &tops)),
             Mode::Walls => println!("{path}\t{done}\t{}\t{}", p.angle_deg, walls_row(&s, &tops)),
+            Mode::Across => {
+                for (from, to, stock) in stock_across(&s) {
+                    println!(
+                        "{path}\t{done}\t{}\t{from:.2}\t{to:.2}\t{stock:.1}",
+                        p.angle_deg
+                    );
+                }
+            }
             Mode::Summary => {
                 let lips = tops.iter().map(|t| t.y).fold(f64::NEG_INFINITY, f64::max);
                 // The aim band's columns: centres within half the distribution range of the middle.
@@ -310,6 +322,36 @@ fn walls_row(s: &Sample, tops: &[Vector]) -> String {
         row.push_str(&format!("\t{:.2}", b * per_grain));
     }
     row
+}
+
+/// Width of `--across`'s strips, in Dg.
+const ACROSS_DG: f64 = 0.25;
+
+/// `--across`: the damage stock in vertical strips ACROSS_DG wide from the box's left side
+/// (x in Dg from the box's middle, stock in mg per g of one grain): where across the box the
+/// stock lies, upstream, under the aim band and downstream.
+fn stock_across(s: &Sample) -> Vec<(f64, f64, f64)> {
+    let p = s.params();
+    let dg = p.grain_diameter_m;
+    let per_grain = 1e3 / p.grain_mass_kg_m();
+    let half = 0.5 * p.surface_width_dg;
+    let strips = (p.surface_width_dg / ACROSS_DG).ceil() as usize;
+    let mut stock = vec![0.0; strips];
+    let surface = s.surface();
+    for i in (0..surface.len()).filter(|&i| surface.flags[i] & KINEMATIC == 0) {
+        let k = ((surface.pos[i].x / dg + half) / ACROSS_DG)
+            .floor()
+            .max(0.0) as usize;
+        stock[k.min(strips - 1)] += surface.mass[i] * surface.damage[i];
+    }
+    stock
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let from = k as f64 * ACROSS_DG - half;
+            (from, from + ACROSS_DG, m * per_grain)
+        })
+        .collect()
 }
 
 /// Distance from `x` to the nearest column top: its depth below the worn surface.
