@@ -13,13 +13,15 @@ path, campaign, cell, lo, hi = sys.argv[1:6]
 lo, hi = int(lo), int(hi)
 by = {}
 for line in open(path).read().splitlines()[1:]:
-    ckpt, _, _, x0, x1, stock = line.split("\t")
+    ckpt, n, _, x0, x1, stock = line.split("\t")
     parts = ckpt.split("/")
     if len(parts) < 2 or parts[-2] != campaign:
         continue
-    c, s, n = parts[-1][1:].removesuffix(".ckpt").split("-")
-    if c == cell and int(n) in (lo, hi):
-        by.setdefault(int(s), {}).setdefault(int(n), {})[(float(x0), float(x1))] = float(stock)
+    # The impacts a checkpoint holds are its own, not its file name's.
+    c, s, _ = parts[-1][1:].removesuffix(".ckpt").split("-")
+    n = int(n)
+    if c == cell and n in (lo, hi):
+        by.setdefault(int(s), {}).setdefault(n, {})[(float(x0), float(x1))] = float(stock)
 pairs = [v for v in by.values() if lo in v and hi in v]
 if not pairs:
     sys.exit(f"no sample of {campaign} cell {cell} has checkpoints at both {lo} and {hi}")

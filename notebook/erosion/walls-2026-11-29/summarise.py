@@ -33,9 +33,11 @@ for r in rows:
     parts = r[0].split("/")
     if len(parts) < 2 or parts[-2] != campaign:
         continue
-    c, s, n = parts[-1][1:].removesuffix(".ckpt").split("-")
-    if c == cell and int(n) in (lo, hi):
-        by.setdefault(int(s), {})[int(n)] = regions(r)
+    # The impacts a checkpoint holds are its own, not its file name's.
+    c, s, _ = parts[-1][1:].removesuffix(".ckpt").split("-")
+    n = int(r[col["impacts"]])
+    if c == cell and n in (lo, hi):
+        by.setdefault(int(s), {})[n] = regions(r)
 pairs = [v for v in by.values() if lo in v and hi in v]
 if not pairs:
     sys.exit(f"no sample of {campaign} cell {cell} has checkpoints at both {lo} and {hi}")
