@@ -6,32 +6,20 @@ Pairs CAMPAIGN's CELL checkpoints at LO and HI impacts by sample (paths
 middle; a grain at an angle travels towards +x), the stock at HI and its growth per impact over
 LO..HI, mean ± standard error over the samples, in mg per g of one grain.
 """
-import math
 import sys
+
+from kept import mean_se, paired, which
 
 path, campaign, cell, lo, hi = sys.argv[1:6]
 lo, hi = int(lo), int(hi)
 by = {}
 for line in open(path).read().splitlines()[1:]:
     ckpt, n, _, x0, x1, stock = line.split("\t")
-    parts = ckpt.split("/")
-    if len(parts) < 2 or parts[-2] != campaign:
-        continue
-    # The impacts a checkpoint holds are its own, not its file name's.
-    c, s, _ = parts[-1][1:].removesuffix(".ckpt").split("-")
+    w = which(ckpt, campaign)
     n = int(n)
-    if c == cell and n in (lo, hi):
-        by.setdefault(int(s), {}).setdefault(n, {})[(float(x0), float(x1))] = float(stock)
-pairs = [v for v in by.values() if lo in v and hi in v]
-if not pairs:
-    sys.exit(f"no sample of {campaign} cell {cell} has checkpoints at both {lo} and {hi}")
-
-
-def mean_se(xs):
-    m = sum(xs) / len(xs)
-    if len(xs) < 2:
-        return m, float("nan")
-    return m, math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1) / len(xs))
+    if w and w[0] == cell and n in (lo, hi):
+        by.setdefault(w[1], {}).setdefault(n, {})[(float(x0), float(x1))] = float(stock)
+pairs = paired(by, lo, hi, f"{campaign} cell {cell}")
 
 
 print(f"{campaign} cell {cell}, impacts {lo}-{hi}, {len(pairs)} samples")

@@ -6,15 +6,13 @@ box's left (upstream) side to its right, in mg per g of one grain.
 """
 import sys
 
+from kept import which
+
 path, campaign, cell, sample = sys.argv[1:5]
 rows = {}
 for line in open(path).read().splitlines()[1:]:
     ckpt, n, _, x0, _, stock = line.split("\t")
-    parts = ckpt.split("/")
-    if len(parts) < 2 or parts[-2] != campaign:
-        continue
-    c, s, _ = parts[-1][1:].removesuffix(".ckpt").split("-")
-    if (c, s) == (cell, sample):
+    if which(ckpt, campaign) == (cell, int(sample)):
         rows.setdefault(int(n), {})[float(x0)] = float(stock)
 if not rows:
     sys.exit(f"no checkpoint of {campaign} cell {cell} sample {sample}")

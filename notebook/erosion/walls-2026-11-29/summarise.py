@@ -5,8 +5,9 @@ Takes the checkpoints of CAMPAIGN's CELL (paths .../CAMPAIGN/cCELL-SAMPLE-IMPACT
 HI impacts, pairs them by sample, and prints each region's stock at HI and its growth per impact
 over LO..HI (mean ± standard error over samples; mg per g of one grain).
 """
-import math
 import sys
+
+from kept import mean_se, paired, which
 
 path, campaign, cell, lo, hi = sys.argv[1:6]
 lo, hi = int(lo), int(hi)
@@ -30,24 +31,11 @@ def regions(r):
 
 by = {}
 for r in rows:
-    parts = r[0].split("/")
-    if len(parts) < 2 or parts[-2] != campaign:
-        continue
-    # The impacts a checkpoint holds are its own, not its file name's.
-    c, s, _ = parts[-1][1:].removesuffix(".ckpt").split("-")
+    w = which(r[0], campaign)
     n = int(r[col["impacts"]])
-    if c == cell and n in (lo, hi):
-        by.setdefault(int(s), {})[n] = regions(r)
-pairs = [v for v in by.values() if lo in v and hi in v]
-if not pairs:
-    sys.exit(f"no sample of {campaign} cell {cell} has checkpoints at both {lo} and {hi}")
-
-
-def mean_se(xs):
-    m = sum(xs) / len(xs)
-    if len(xs) < 2:
-        return m, float("nan")
-    return m, math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1) / len(xs))
+    if w and w[0] == cell and n in (lo, hi):
+        by.setdefault(w[1], {})[n] = regions(r)
+pairs = paired(by, lo, hi, f"{campaign} cell {cell}")
 
 
 print(f"{campaign} cell {cell}, impacts {lo}-{hi}, {len(pairs)} samples")
