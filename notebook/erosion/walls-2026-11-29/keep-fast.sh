@@ -1,0 +1,14 @@
+#!/bin/bash
+# Every minute, copies the replaying campaigns' checkpoints at multiples of 20 impacts (the
+# keeper proper looks every 10 minutes, too rarely for 16 and 24 per Dg).
+while true; do
+  for c in ppd16c ppd24b; do
+    mkdir -p /work/runs/ckpt-keep/$c
+    sqlite3 /work/runs/$c/grit.db "select j.cell_index||'-'||j.sample_index, k.units_done, k.job_id from checkpoints k join jobs j on j.id = k.job_id where k.units_done % 20 = 0" 2>/dev/null |
+    while IFS='|' read name n id; do
+      f=/work/runs/ckpt-keep/$c/c$name-$n.ckpt
+      [ -e "$f" ] || sqlite3 /work/runs/$c/grit.db "select writefile('$f', data) from checkpoints where job_id=$id and units_done=$n" >/dev/null 2>&1
+    done
+  done
+  sleep 50
+done
