@@ -330,9 +330,9 @@ pub async fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-/// An impact cell's line: the seed's erosion (section 4, last-20 slope) and the damage
-/// balance (docs/erosion.md): mean ± std over samples, the last window's loss/damage added, and the loss over
-/// the last 60 impacts with its standard error.
+/// An impact cell's line: the seed's erosion (section 4, last-20 slope) as mean ± std over
+/// samples, and the damage balance (docs/erosion.md): the last window's loss/damage added and
+/// the loss over the last 60 impacts with its standard error.
 fn impact_cell_line(c: &grit_erosion::CellResult) -> String {
     let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.4e}"));
     // Below 1 while the surface still stores more damage than it loses.
