@@ -12,7 +12,8 @@
 //! worn surface keeps the damage its impacts added and have not yet removed. `--walls` gives
 //! the stock within 0.1, 0.25 and 0.5 Dg of the box's fixed bottom and sides: whether the
 //! damage reaches the edges the box holds fixed. `--across` gives the stock in strips 0.25 Dg
-//! wide across the box.
+//! wide across the box. `--band-depth` splits the stock under the aim band by depth below the
+//! surface in Δx: whether a rung's stock is a layer a few particles thick or a physical depth.
 //! `--incidence` sweeps the seed's grains (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
@@ -25,7 +26,8 @@
 //! every impact, where its grain first touched the surface just before it and at what local
 //! angle, with its damage added and loss (OUT-impacts.tsv), and every 20 impacts each sample's
 //! column tops (OUT-columns.tsv).
-//! Usage: `surface_profile [--columns | --incidence | --stock | --walls | --across] CHECKPOINT…`,
+//! Usage: `surface_profile [--columns | --incidence | --stock | --walls | --across |
+//! --band-depth] CHECKPOINT…`,
 //! `surface_profile --grains FILE` or `surface_profile --run …`.
 use grit_erosion::impact::{GrainStart, ImpactParams};
 use grit_erosion::{Sample, Shape};
@@ -47,6 +49,7 @@ enum Mode {
     Stock,
     Walls,
     Across,
+    BandDepth,
 }
 
 /// A fired grain to place on a checkpoint's surface: its impact number, orientation, aim.
@@ -72,6 +75,7 @@ fn main() {
         Some("--stock") => Mode::Stock,
         Some("--walls") => Mode::Walls,
         Some("--across") => Mode::Across,
+        Some("--band-depth") => Mode::BandDepth,
         Some("--run") => return run(&args[1..]),
         _ => Mode::Summary,
     };
@@ -117,6 +121,7 @@ fn main() {
             Mode::Stock => STOCK_HEADER,
             Mode::Walls => WALLS_HEADER,
             Mode::Across => "checkpoint\timpacts\tangle_deg\tx_from_dg\tx_to_dg\tstock",
+            Mode::BandDepth => "checkpoint\timpacts\tangle_deg\tppd\tband_line_dg\tfrom_dx\tto_dx\tstock\tmass",
         }
     );
     for (path, fired) in &work {
@@ -169,6 +174,16 @@ fn main() {
                     );
                 }
             }
+            Mode::BandDepth => {
+                let (band_line, bins) = band_depth(&s, &tops);
+                for (from, to, stock, mass) in bins {
+                    println!(
+                        "{path}\t{done}\t{}\t{:.1}\t{band_line:.3}\t{from}\t{to}\t{stock:.2}\t{mass:.1}",
+                        p.angle_deg,
+                        dg / p.spacing_m
+                    );
+                }
+            }
             Mode::Summary => {
                 let lips = tops.iter().map(|t| t.y).fold(f64::NEG_INFINITY, f64::max);
                 // The aim band's columns: centres within half the distribution range of the middle.
@@ -206,14 +221,7 @@ fn stock_row(s: &Sample, tops: &[Vector]) -> String {
     let dg = p.grain_diameter_m;
     let per_grain = 1e3 / p.grain_mass_kg_m();
     let reach = 0.5 * p.distribution_range_dg * dg;
-    let (mut line, mut band_line) = (0.0, 0.0);
-    for w in tops.windows(2) {
-        let l = (w[1] - w[0]).norm();
-        line += l;
-        if 0.5 * (w[0].x + w[1].x).abs() <= reach {
-            band_line += l;
-        }
-    }
+    let (line, band_line) = surface_lines(tops, reach);
     let surface = s.surface();
     let (mut stock, mut band_stock) = (0.0, 0.0);
     let mut by_depth = [0.0; STOCK_DEPTHS_DG.len() + 1];
@@ -352,6 +360,63 @@ fn stock_across(s: &Sample) -> Vec<(f64, f64, f64)> {
             (from, from + ACROSS_DG, m * per_grain)
         })
         .collect()
+}
+
+/// Length of the surface line through the column tops, over the box and over the columns
+/// within `reach` of the middle (m).
+fn surface_lines(tops: &[Vector], reach: f64) -> (f64, f64) {
+    let (mut line, mut band_line) = (0.0, 0.0);
+    for w in tops.windows(2) {
+        let l = (w[1] - w[0]).norm();
+        line += l;
+        if 0.5 * (w[0].x + w[1].x).abs() <= reach {
+            band_line += l;
+        }
+    }
+    (line, band_line)
+}
+
+/// Upper edges of `--band-depth`'s bins in Δx below the surface, centred on the lattice's
+/// layers near the top; the last bin is open.
+const BAND_DEPTHS_DX: [f64; 10] = [0.5, 1.5, 2.5, 3.5, 5.0, 8.0, 12.0, 16.0, 24.0, 32.0];
+
+/// `--band-depth`: the surface line's length over the aim band (Dg) and, per depth bin, the
+/// damage stock Σ m D and the mass Σ m of the free particles under the band (|x| within half
+/// the aim range), as (from, to in Δx, stock, mass, both in mg per g of one grain; their ratio
+/// is the bin's mean damage); the last bin's upper edge is infinite.
+fn band_depth(s: &Sample, tops: &[Vector]) -> (f64, Vec<(f64, f64, f64, f64)>) {
+    let p = s.params();
+    let dg = p.grain_diameter_m;
+    let per_grain = 1e3 / p.grain_mass_kg_m();
+    let reach = 0.5 * p.distribution_range_dg * dg;
+    let (_, band_line) = surface_lines(tops, reach);
+    let mut stock = [0.0; BAND_DEPTHS_DX.len() + 1];
+    let mut mass = [0.0; BAND_DEPTHS_DX.len() + 1];
+    let surface = s.surface();
+    for i in (0..surface.len()).filter(|&i| surface.flags[i] & KINEMATIC == 0) {
+        let x = surface.pos[i];
+        if x.x.abs() > reach {
+            continue;
+        }
+        let depth = depth_below(tops, x) / p.spacing_m;
+        let bin = BAND_DEPTHS_DX
+            .iter()
+            .position(|&edge| depth < edge)
+            .unwrap_or(BAND_DEPTHS_DX.len());
+        stock[bin] += surface.mass[i] * surface.damage[i];
+        mass[bin] += surface.mass[i];
+    }
+    let bins = stock
+        .iter()
+        .zip(&mass)
+        .enumerate()
+        .map(|(k, (md, m))| {
+            let from = if k == 0 { 0.0 } else { BAND_DEPTHS_DX[k - 1] };
+            let to = BAND_DEPTHS_DX.get(k).copied().unwrap_or(f64::INFINITY);
+            (from, to, md * per_grain, m * per_grain)
+        })
+        .collect();
+    (band_line / dg, bins)
 }
 
 /// Distance from `x` to the nearest column top: its depth below the worn surface.

@@ -1,8 +1,9 @@
 #!/bin/bash
-# Every minute, copies the replaying campaigns' checkpoints at multiples of 20 impacts (the
-# keeper proper looks every 10 minutes, too rarely for 16 and 24 per Dg).
+# Every minute, copies every campaign's checkpoints at multiples of 20 impacts (the keeper
+# proper looks every 10 minutes, too rarely to catch them): the stock inside the box at each
+# 20-impact window is what judges stationarity away from the box's fixed sides.
 while true; do
-  for c in ppd16c ppd24b; do
+  for c in ppd16c ppd24b paper ppd48; do
     mkdir -p /work/runs/ckpt-keep/$c
     sqlite3 /work/runs/$c/grit.db "select j.cell_index||'-'||j.sample_index, k.units_done, k.job_id from checkpoints k join jobs j on j.id = k.job_id where k.units_done % 20 = 0" 2>/dev/null |
     while IFS='|' read name n id; do
