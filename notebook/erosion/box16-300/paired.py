@@ -34,7 +34,7 @@ def main():
         if k:
             at = (k, int(r[1]))
             v[at]["band"] += float(r[7])
-            v[at]["skin" if r[6] != "inf" and float(r[6]) <= 2.5 else "below"] += float(r[7])
+            v[at]["skin" if float(r[6]) <= 2.5 else "below"] += float(r[7])
     rows = [l.rstrip("\n").split("\t") for l in open(walls)]
     col = rows[0].index("stock")
     for r in rows[1:]:
