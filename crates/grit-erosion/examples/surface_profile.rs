@@ -12,7 +12,9 @@
 //! worn surface keeps the damage its impacts added and have not yet removed. `--walls` gives
 //! the stock within 0.1, 0.25 and 0.5 Dg of the box's fixed bottom and sides: whether the
 //! damage reaches the edges the box holds fixed. `--across` gives the stock in strips 0.25 Dg
-//! wide across the box. `--band-depth` splits the stock under the aim band by depth below the
+//! wide across the box. `--removed` gives, for each pair of consecutive checkpoints of one
+//! sample, the mass of the particles the later one no longer has, in the same strips, placed
+//! where they were in the earlier one: where across the box the loss is made. `--band-depth` splits the stock under the aim band by depth below the
 //! surface in Δx: whether a rung's stock is a layer a few particles thick or a physical depth.
 //! `--incidence` sweeps the seed's grains (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
@@ -27,7 +29,7 @@
 //! angle, with its damage added and loss (OUT-impacts.tsv), and every 20 impacts each sample's
 //! column tops (OUT-columns.tsv).
 //! Usage: `surface_profile [--columns | --incidence | --stock | --walls | --across |
-//! --band-depth] CHECKPOINT…`,
+//! --removed | --band-depth] CHECKPOINT…`,
 //! `surface_profile --grains FILE` or `surface_profile --run …`.
 use grit_erosion::impact::{GrainStart, ImpactParams};
 use grit_erosion::{Sample, Shape};
@@ -61,7 +63,7 @@ struct Fired {
 
 fn usage() -> ! {
     eprintln!(
-        "usage: surface_profile [--columns | --incidence | --stock | --walls | --across] CHECKPOINT… | --grains FILE | --run …"
+        "usage: surface_profile [--columns | --incidence | --stock | --walls | --across | --removed | --band-depth] CHECKPOINT… | --grains FILE | --run …"
     );
     std::process::exit(2);
 }
@@ -76,6 +78,7 @@ fn main() {
         Some("--walls") => Mode::Walls,
         Some("--across") => Mode::Across,
         Some("--band-depth") => Mode::BandDepth,
+        Some("--removed") => return removed(&args[1..]),
         Some("--run") => return run(&args[1..]),
         _ => Mode::Summary,
     };
@@ -340,17 +343,12 @@ const ACROSS_DG: f64 = 0.25;
 /// stock lies, upstream, under the aim band and downstream.
 fn stock_across(s: &Sample) -> Vec<(f64, f64, f64)> {
     let p = s.params();
-    let dg = p.grain_diameter_m;
     let per_grain = 1e3 / p.grain_mass_kg_m();
     let half = 0.5 * p.surface_width_dg;
-    let strips = (p.surface_width_dg / ACROSS_DG).ceil() as usize;
-    let mut stock = vec![0.0; strips];
+    let mut stock = vec![0.0; strips(p)];
     let surface = s.surface();
     for i in (0..surface.len()).filter(|&i| surface.flags[i] & KINEMATIC == 0) {
-        let k = ((surface.pos[i].x / dg + half) / ACROSS_DG)
-            .floor()
-            .max(0.0) as usize;
-        stock[k.min(strips - 1)] += surface.mass[i] * surface.damage[i];
+        stock[strip(p, surface.pos[i].x)] += surface.mass[i] * surface.damage[i];
     }
     stock
         .iter()
@@ -360,6 +358,60 @@ fn stock_across(s: &Sample) -> Vec<(f64, f64, f64)> {
             (from, from + ACROSS_DG, m * per_grain)
         })
         .collect()
+}
+
+/// Number of `--across` strips over the box.
+fn strips(p: &ImpactParams) -> usize {
+    (p.surface_width_dg / ACROSS_DG).ceil() as usize
+}
+
+/// The `--across` strip holding abscissa `x` (m from the box's middle).
+fn strip(p: &ImpactParams, x: f64) -> usize {
+    let k = ((x / p.grain_diameter_m + 0.5 * p.surface_width_dg) / ACROSS_DG).floor();
+    (k.max(0.0) as usize).min(strips(p) - 1)
+}
+
+/// `--removed`: per pair of consecutive checkpoints of one sample (the same seed, more impacts
+/// in the later), the mass of the particles whose ids the later one lacks, in strips
+/// ACROSS_DG wide at their places in the earlier one (mg per g of one grain). A pair whose
+/// seeds differ or whose impacts do not grow is a new sample's start, not a pair.
+fn removed(paths: &[String]) {
+    if paths.len() < 2 {
+        usage();
+    }
+    println!("checkpoint\timpacts_from\timpacts_to\tangle_deg\tx_from_dg\tx_to_dg\tremoved");
+    let load = |path: &String| {
+        let bytes = std::fs::read(path).expect("read checkpoint");
+        Sample::from_checkpoint(&bytes).expect("checkpoint")
+    };
+    let mut earlier = load(&paths[0]);
+    for (i, path) in paths.iter().enumerate().skip(1) {
+        let later = load(path);
+        if later.seed() == earlier.seed() && later.impacts_done() > earlier.impacts_done() {
+            let p = earlier.params();
+            let per_grain = 1e3 / p.grain_mass_kg_m();
+            let half = 0.5 * p.surface_width_dg;
+            let kept: std::collections::HashSet<u32> = later.surface().id.iter().copied().collect();
+            let mut lost = vec![0.0; strips(p)];
+            let surface = earlier.surface();
+            for j in (0..surface.len()).filter(|&j| !kept.contains(&surface.id[j])) {
+                lost[strip(p, surface.pos[j].x)] += surface.mass[j];
+            }
+            for (k, m) in lost.iter().enumerate() {
+                let from = k as f64 * ACROSS_DG - half;
+                println!(
+                    "{}\t{}\t{}\t{}\t{from:.2}\t{:.2}\t{:.2}",
+                    paths[i - 1],
+                    earlier.impacts_done(),
+                    later.impacts_done(),
+                    p.angle_deg,
+                    from + ACROSS_DG,
+                    m * per_grain
+                );
+            }
+        }
+        earlier = later;
+    }
 }
 
 /// Length of the surface line through the column tops, over the box and over the columns
