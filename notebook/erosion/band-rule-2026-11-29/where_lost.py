@@ -25,10 +25,12 @@ def zone(lo, hi):
     return "further out"
 
 
-def main():
-    path, block = sys.argv[1], int(sys.argv[2])
-    first = int(sys.argv[3]) if len(sys.argv) > 3 else 0
-    # (angle, sample, block start) -> zone -> removed, and the pairs' impacts covered
+ZONES = ["band", "upstream walls", "downstream walls", "further out"]
+
+
+def pool(path, block, first=0):
+    """{(angle, sample, block start): {zone: removed}} over the samples that have every pair of
+    the block (mg per g of one grain, summed over the block's pairs)."""
     got = collections.defaultdict(lambda: collections.defaultdict(float))
     span = collections.defaultdict(int)
     rows = [l.rstrip("\n").split("\t") for l in open(path)][1:]
@@ -43,18 +45,22 @@ def main():
         got[(angle, s, start)][zone(float(r[4]), float(r[5]))] += float(r[6])
         if float(r[4]) == float(rows[0][4]):
             span[(angle, s, start)] += b - a
-    zones = ["band", "upstream walls", "downstream walls", "further out"]
-    print("| angle | impacts | samples | all | " + " | ".join(zones) + " | share outside the band |")
-    print("|---|---|---|---|" + "---|" * len(zones) + "---|")
+    return {k: v for k, v in got.items() if span[k] == block}
+
+
+def main():
+    path, block = sys.argv[1], int(sys.argv[2])
+    first = int(sys.argv[3]) if len(sys.argv) > 3 else 0
+    got = pool(path, block, first)
+    print("| angle | impacts | samples | all | " + " | ".join(ZONES) + " | share outside the band |")
+    print("|---|---|---|---|" + "---|" * len(ZONES) + "---|")
     for angle, start in sorted({(k[0], k[2]) for k in got}, key=lambda k: (float(k[0]), k[1])):
-        keys = [k for k in got if k[0] == angle and k[2] == start and span[k] == block]
-        if not keys:
-            continue
-        per = {z: [got[k][z] / block for k in keys] for z in zones}
+        keys = [k for k in got if k[0] == angle and k[2] == start]
+        per = {z: [got[k][z] / block for k in keys] for z in ZONES}
         alls = [sum(got[k].values()) / block for k in keys]
         out = [1 - got[k]["band"] / sum(got[k].values()) for k in keys if sum(got[k].values()) > 0]
         print(f"| {angle}° | {start + 1}–{start + block} | {len(keys)} | {mean_se(alls)} | "
-              + " | ".join(mean_se(per[z]) for z in zones) + f" | {mean_se(out) if out else '-'} |")
+              + " | ".join(mean_se(per[z]) for z in ZONES) + f" | {mean_se(out) if out else '-'} |")
 
 
 if __name__ == "__main__":
