@@ -1,5 +1,5 @@
 """Where the loss is made in two boxes that meet the same grains, paired sample by sample.
-usage: where_paired.py STD_REMOVED.tsv BIG_REMOVED.tsv BLOCK
+usage: where_paired.py STD_REMOVED.tsv BIG_REMOVED.tsv BLOCK [FIRST]
 Per angle, block and zone (where_lost.py's): the mass removed per impact (mg/g) in each box and
 the paired difference big - std over the samples both have, mean ± standard error."""
 import sys
@@ -8,7 +8,9 @@ from where_lost import ZONES, mean_se, pool
 
 
 def main():
-    std, big, block = pool(sys.argv[1], int(sys.argv[3])), pool(sys.argv[2], int(sys.argv[3])), int(sys.argv[3])
+    block = int(sys.argv[3])
+    first = int(sys.argv[4]) if len(sys.argv) > 4 else 0
+    std, big = pool(sys.argv[1], block, first), pool(sys.argv[2], block, first)
     print("| angle | impacts | samples | zone | 3.0 Dg box | 4.5 Dg box | difference |")
     print("|---|---|---|---|---|---|---|")
     for angle, start in sorted({(k[0], k[2]) for k in big}, key=lambda k: (float(k[0]), k[1])):
