@@ -14,8 +14,9 @@
 //! damage reaches the edges the box holds fixed. `--across` gives the stock in strips 0.25 Dg
 //! wide across the box. `--removed` gives, for each pair of consecutive checkpoints of one
 //! sample, the mass of the particles the later one no longer has, in the same strips, placed
-//! where they were in the earlier one: where across the box the loss is made. `--band-depth` splits the stock under the aim band by depth below the
-//! surface in Δx: whether a rung's stock is a layer a few particles thick or a physical depth.
+//! where they were in the earlier one: where across the box the loss is made. `--band-depth`
+//! splits the stock under the aim band by depth below the surface in Δx: whether a rung's
+//! stock is a layer a few particles thick or a physical depth.
 //! `--incidence` sweeps the seed's grains (a grid of orientations and aim points, placed as `ImpactParams::grain_start` places them)
 //! along their paths onto the column tops and prints, per grain, where it first touches and
 //! the angle between its path and the surface there, the slope taken over ±0.1 Dg: how far a
