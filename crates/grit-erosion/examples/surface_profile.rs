@@ -129,8 +129,7 @@ fn main() {
         }
     );
     for (path, fired) in &work {
-        let bytes = std::fs::read(path).expect("read checkpoint");
-        let s = Sample::from_checkpoint(&bytes).expect("checkpoint");
+        let s = load(path);
         let p = s.params();
         let dg = p.grain_diameter_m;
         let tops = column_tops(&s);
@@ -344,21 +343,12 @@ const ACROSS_DG: f64 = 0.25;
 /// stock lies, upstream, under the aim band and downstream.
 fn stock_across(s: &Sample) -> Vec<(f64, f64, f64)> {
     let p = s.params();
-    let per_grain = 1e3 / p.grain_mass_kg_m();
-    let half = 0.5 * p.surface_width_dg;
     let mut stock = vec![0.0; strips(p)];
     let surface = s.surface();
     for i in (0..surface.len()).filter(|&i| surface.flags[i] & KINEMATIC == 0) {
         stock[strip(p, surface.pos[i].x)] += surface.mass[i] * surface.damage[i];
     }
-    stock
-        .iter()
-        .enumerate()
-        .map(|(k, m)| {
-            let from = k as f64 * ACROSS_DG - half;
-            (from, from + ACROSS_DG, m * per_grain)
-        })
-        .collect()
+    strip_rows(p, &stock)
 }
 
 /// Number of `--across` strips over the box.
@@ -372,6 +362,26 @@ fn strip(p: &ImpactParams, x: f64) -> usize {
     (k.max(0.0) as usize).min(strips(p) - 1)
 }
 
+/// Per-strip masses (kg/m) as (from, to in Dg from the box's middle, mg per g of one grain).
+fn strip_rows(p: &ImpactParams, masses: &[f64]) -> Vec<(f64, f64, f64)> {
+    let per_grain = 1e3 / p.grain_mass_kg_m();
+    let half = 0.5 * p.surface_width_dg;
+    masses
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let from = k as f64 * ACROSS_DG - half;
+            (from, from + ACROSS_DG, m * per_grain)
+        })
+        .collect()
+}
+
+/// A checkpoint file's sample.
+fn load(path: &str) -> Sample {
+    let bytes = std::fs::read(path).expect("read checkpoint");
+    Sample::from_checkpoint(&bytes).expect("checkpoint")
+}
+
 /// `--removed`: per pair of consecutive checkpoints of one sample (the same seed, more impacts
 /// in the later), the mass of the particles whose ids the later one lacks, in strips
 /// ACROSS_DG wide at their places in the earlier one (mg per g of one grain). A pair whose
@@ -381,33 +391,24 @@ fn removed(paths: &[String]) {
         usage();
     }
     println!("checkpoint\timpacts_from\timpacts_to\tangle_deg\tx_from_dg\tx_to_dg\tremoved");
-    let load = |path: &String| {
-        let bytes = std::fs::read(path).expect("read checkpoint");
-        Sample::from_checkpoint(&bytes).expect("checkpoint")
-    };
     let mut earlier = load(&paths[0]);
     for (i, path) in paths.iter().enumerate().skip(1) {
         let later = load(path);
         if later.seed() == earlier.seed() && later.impacts_done() > earlier.impacts_done() {
             let p = earlier.params();
-            let per_grain = 1e3 / p.grain_mass_kg_m();
-            let half = 0.5 * p.surface_width_dg;
             let kept: std::collections::HashSet<u32> = later.surface().id.iter().copied().collect();
             let mut lost = vec![0.0; strips(p)];
             let surface = earlier.surface();
             for j in (0..surface.len()).filter(|&j| !kept.contains(&surface.id[j])) {
                 lost[strip(p, surface.pos[j].x)] += surface.mass[j];
             }
-            for (k, m) in lost.iter().enumerate() {
-                let from = k as f64 * ACROSS_DG - half;
+            for (from, to, removed) in strip_rows(p, &lost) {
                 println!(
-                    "{}\t{}\t{}\t{}\t{from:.2}\t{:.2}\t{:.2}",
+                    "{}\t{}\t{}\t{}\t{from:.2}\t{to:.2}\t{removed:.2}",
                     paths[i - 1],
                     earlier.impacts_done(),
                     later.impacts_done(),
-                    p.angle_deg,
-                    from + ACROSS_DG,
-                    m * per_grain
+                    p.angle_deg
                 );
             }
         }
