@@ -19,5 +19,6 @@ for run in box300/keep/std box300/keep/big layer/keep/l24 layer/keep/l32 ckpt-ke
   "$bin" --removed $(order "$run"/*.ckpt) > "$out/$name.tsv"
 done
 for name in std big l24 l32; do echo "## $name"; python3 "$here/where_lost.py" "$out/$name.tsv" 40; done
+echo "## l32, 80-impact blocks"; python3 "$here/where_lost.py" "$out/l32.tsv" 80
 echo "## paper"; python3 "$here/where_lost.py" "$out/paper.tsv" 20 220
 echo "## ppd48"; python3 "$here/where_lost.py" "$out/ppd48.tsv" 20 300
