@@ -1,28 +1,36 @@
 #!/bin/bash
-# Starts every long run of issue 40 on the pinned binary, each in its own autogroup with its
-# CPU weight (nice has no effect between setsid processes: campaigns.md, session 35), and the
-# checkpoint keepers. Run from the repository's root after restore.sh has put the folders back:
+# Starts the long runs of issue 40 on the pinned binary in two lanes, one engine thread each,
+# so that exactly one thread runs per core: a run starts when the one before it in its lane
+# has finished. Run from the repository's root after restore.sh has put the folders back:
 #   bash notebook/campaign-state/start.sh
-# Weights (session 44): the paired box runs first, since their verdict decides whether the
-# campaigns' 3.0-Dg box is wide enough; then the seed's campaign and the 48 rung; the 24 and 16
-# rungs last.
+# One thread per core rather than every run at once under autogroup weights: the same 3-impact
+# sample costs 6-9 % more CPU time beside ten engine threads (or three) than two side by side
+# (notebook/performance/oversubscribed-2026-12-01/). The lanes' order is the priority: the
+# paired box runs first (their verdict decides whether the campaigns' box is wide enough), then
+# the 48 rung and the seed's campaign, the 24 and 16 rungs between.
 B=${B:-/work/bins/grit-9d98f72-native-pgo}
 R=${R:-/work/runs}
-start() { # name autogroup workers spec out [extra flags]
-  local name=$1 ag=$2 w=$3 spec=$4 out=$5; shift 5
-  setsid nohup nice -n 12 "$B" run "$spec" --out "$out" --workers "$w" --threads 1 "$@" \
-    >> "$R/$name.log" 2>&1 &
-  local pid=$!
-  sleep 1
-  echo "$ag" > /proc/$pid/autogroup
-  echo "$name: pid $pid, $(cat /proc/$pid/autogroup)"
+run() { # name spec out [extra flags]
+  local name=$1 spec=$2 out=$3; shift 3
+  echo "$(date -u +%FT%TZ) start $name" >> "$R/lanes.log"
+  nice -n 12 "$B" run "$spec" --out "$out" --workers 1 --threads 1 "$@" >> "$R/$name.log" 2>&1
+  echo "$(date -u +%FT%TZ) end $name (exit $?)" >> "$R/lanes.log"
+}
+lane_a() {
+  run box32big notebook/erosion/box32-420/big.json "$R/box32/big" --checkpoint-every 20
+  run ppd48 examples/resolution48-steady.json "$R/ppd48"
+  run ppd16c examples/resolution16-balanced.json "$R/ppd16c"
+}
+lane_b() {
+  run box32std notebook/erosion/box32-420/std.json "$R/box32/std" --checkpoint-every 20
+  run ppd24b examples/resolution24-balanced.json "$R/ppd24b"
+  run paper examples/paper.json "$R/paper"
 }
 mkdir -p "$R/box32"
-start box32big -10 3 notebook/erosion/box32-420/big.json "$R/box32/big" --checkpoint-every 20
-start box32std -5 1 notebook/erosion/box32-420/std.json "$R/box32/std" --checkpoint-every 20
-start paper 0 1 examples/paper.json "$R/paper"
-start ppd48 0 1 examples/resolution48-steady.json "$R/ppd48"
-start ppd24b 8 1 examples/resolution24-balanced.json "$R/ppd24b"
-start ppd16c 8 1 examples/resolution16-balanced.json "$R/ppd16c"
+export -f run lane_a lane_b
+export B R
+setsid nohup bash -c lane_a > /dev/null 2>&1 &
+setsid nohup bash -c lane_b > /dev/null 2>&1 &
 setsid nohup bash notebook/erosion/box16-300/keep.sh "$R/box32" big std > "$R/keep-box32.log" 2>&1 &
 setsid nohup nice -n 15 bash notebook/erosion/walls-2026-11-29/keep-fast.sh > "$R/keep-fast.log" 2>&1 &
+echo "lanes started; see $R/lanes.log"
