@@ -6,8 +6,9 @@
 # One thread per core rather than every run at once under autogroup weights: the same 3-impact
 # sample costs 6-9 % more CPU time beside ten engine threads (or three) than two side by side
 # (notebook/performance/oversubscribed-2026-12-01/). The lanes' order is the priority: the
-# paired box runs first (their verdict decides whether the campaigns' box is wide enough), then
-# the 48 rung and the seed's campaign, the 24 and 16 rungs between.
+# paired box runs first (their verdict decides whether the campaigns' box is wide enough);
+# then lane a takes the 48 rung and after it the 16 rung, lane b the 24 rung (a few CPU-hours
+# to its end) and after it the seed's campaign.
 B=${B:-/work/bins/grit-9d98f72-native-pgo}
 R=${R:-/work/runs}
 run() { # name spec out [extra flags]
