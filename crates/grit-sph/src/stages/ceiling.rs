@@ -3,9 +3,9 @@
 //! full step to say how far the step is from the least any pair loop over the same list costs
 //! (docs/performance.md, "The ceiling").
 
-use super::pairs::PairCache;
+use super::pairs::{PairCache, USED};
 use crate::kernel::Kernel;
-use crate::neighbours::NeighbourLists;
+use crate::neighbours::{HalfIndex, NeighbourLists};
 use crate::particles::Particles;
 
 /// What one bare kernel-sum pass did, so that a caller can keep it observable.
@@ -18,24 +18,31 @@ pub struct CeilingPass {
 }
 
 /// Σ_j V_j W(|x_i − x_j|) for every particle i over its used same-body pairs of the last step
-/// (`cache`), the kernel evaluated per pair from the current positions, on the calling thread.
+/// (`cache`'s flags, in rows the kernel sums counted: a rigid body's are not), the kernel
+/// evaluated per pair from the current positions, on the calling thread.
 pub(crate) fn ceiling(
     p: &Particles,
     nl: &NeighbourLists,
+    hi: &HalfIndex,
     cache: &PairCache,
     vol: &[f64],
     k: &Kernel,
 ) -> CeilingPass {
     let mut out = CeilingPass::default();
     for (i, &xi) in p.pos.iter().enumerate() {
-        let mut g = 0.0;
-        let row = cache.of(nl, i);
-        for s in row {
-            let j = s.j as usize;
-            let r = (xi - p.pos[j]).norm();
-            g += vol[j] * k.w(r);
+        if cache.count[i] == 0 {
+            continue;
         }
-        out.pair_terms += row.len() as u64;
+        let mut g = 0.0;
+        let ids = &hi.id[nl.start[i] as usize..];
+        for (&j, &id) in nl.of(i).iter().zip(ids) {
+            if cache.flags[id as usize] & USED == 0 {
+                continue;
+            }
+            let r = (xi - p.pos[j as usize]).norm();
+            g += vol[j as usize] * k.w(r);
+            out.pair_terms += 1;
+        }
         out.sum += g;
     }
     out

@@ -5,7 +5,9 @@
 use rayon::prelude::*;
 
 use super::pairs::{row_blocks, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
-use super::{KernelSums, ParTasks, SphView, StepCtx, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS};
+use super::{
+    BodyConst, KernelSums, ParTasks, SphView, StepCtx, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS,
+};
 use crate::math::{Matrix, Vector};
 use crate::particles::KINEMATIC;
 
@@ -76,6 +78,94 @@ pub(crate) fn forces(
         Vec::new()
     };
     let hourglass_on = |pair: &HalfPair| alpha > 0.0 && pair.w > 0.0;
+    // The terms pair (i, j), i < j, shares between its particles (`PairForce`); c is the body's.
+    let pair_force = |i: usize, j: usize, pair: &HalfPair, bits: u8, c: &BodyConst| {
+        if bits & APART == 0 {
+            return PairForce::default();
+        }
+        let HalfPair { xij, dw_r, .. } = *pair;
+        let mut stress = (sig[i] + sig[j]) * (xij * dw_r);
+        if let Some(av) = &av {
+            let (vij, rho_mean) = (p.vel[i] - p.vel[j], 0.5 * (p.rho[i] + p.rho[j]));
+            stress -= xij * (dw_r * av.pi_ab(xij, vij, c.sound, rho_mean, h));
+        }
+        let mut hourglass = Vector::zeros();
+        if hourglass_on(pair) {
+            let r = pair.r();
+            let e = xij / r;
+            // Viscous part: velocity error against the mean velocity gradient.
+            let vij = p.vel[i] - p.vel[j];
+            let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
+            let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
+            // Stiffness part: separation error against the mean deformation gradient.
+            let stiff = if bits & NEAR_REF != 0 {
+                let xr = p.x_ref[i] - p.x_ref[j];
+                let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
+                c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
+            } else {
+                0.0
+            };
+            // Heavily sheared material can bring two particles almost on top of
+            // each other; 1/r² then makes the pair force stiff enough to blow the
+            // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
+            // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
+            let rr = r.max(HG_MIN_SEPARATION_H * h);
+            // Not the kernel sums' volumes: the stress stage has moved ρ since
+            // (continuity), and both volumes must be the same step's.
+            let cij = alpha * vol[i] * vol[j] * pair.w / (rr * rr);
+            hourglass = e * (cij * 0.5 * (stiff + visc));
+        }
+        PairForce { stress, hourglass }
+    };
+    // The particle's acceleration from its pair sums a (stress) and fhg (hourglass force).
+    let finish = |i: usize, a: Vector, fhg: Vector| {
+        if !is_active(i) {
+            return ParticleForce {
+                acc: if moving(i) { g } else { Vector::zeros() },
+                hourglass_work: 0.0,
+            };
+        }
+        ParticleForce {
+            acc: a + fhg / p.mass[i] + g,
+            hourglass_work: fhg.dot(&p.vel[i]) * dt,
+        }
+    };
+    let n = p.len();
+    accel.resize(n, Vector::zeros());
+    if rayon::current_num_threads() == 1 {
+        // One thread: each pair's shared terms go straight to both particles, in id order.
+        // Particle i gets them from its lower partners' rows, in increasing index, before its
+        // own row's: its row's order, so every sum is bitwise the gather's below.
+        let mut a = vec![Vector::zeros(); n];
+        let mut fhg = vec![Vector::zeros(); n];
+        for i in (0..n).filter(|_| any_pairs) {
+            let at = hi.start[i] as usize;
+            let pairs = cache.half[at..].iter().zip(&cache.flags[at..]);
+            let c = bc[p.body[i] as usize];
+            for (&j, (pair, &bits)) in hi.upper_of(nl, i).iter().zip(pairs) {
+                let j = j as usize;
+                if bits & USED == 0 || !(active[i] || active[j]) {
+                    continue;
+                }
+                let f = pair_force(i, j, pair, bits, &c);
+                if active[i] {
+                    a[i] += f.stress * p.mass[j];
+                    fhg[i] -= f.hourglass;
+                }
+                if active[j] {
+                    a[j] += -f.stress * p.mass[i];
+                    fhg[j] -= -f.hourglass;
+                }
+            }
+        }
+        let mut work = 0.0;
+        for (i, acc) in accel.iter_mut().enumerate() {
+            let f = finish(i, a[i], fhg[i]);
+            *acc = f.acc;
+            work += f.hourglass_work;
+        }
+        return work;
+    }
     let blocks = if any_pairs {
         row_blocks(shared, &hi.start)
     } else {
@@ -94,54 +184,14 @@ pub(crate) fn forces(
                 if bits & USED == 0 || !(active[i] || active[j]) {
                     continue;
                 }
-                if bits & APART == 0 {
-                    *out = PairForce::default();
-                    continue;
-                }
-                let HalfPair { xij, dw_r, .. } = *pair;
-                let mut stress = (sig[i] + sig[j]) * (xij * dw_r);
-                if let Some(av) = &av {
-                    let (vij, rho_mean) = (p.vel[i] - p.vel[j], 0.5 * (p.rho[i] + p.rho[j]));
-                    stress -= xij * (dw_r * av.pi_ab(xij, vij, c.sound, rho_mean, h));
-                }
-                let mut hourglass = Vector::zeros();
-                if hourglass_on(pair) {
-                    let r = pair.r();
-                    let e = xij / r;
-                    // Viscous part: velocity error against the mean velocity gradient.
-                    let vij = p.vel[i] - p.vel[j];
-                    let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
-                    let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
-                    // Stiffness part: separation error against the mean deformation gradient.
-                    let stiff = if bits & NEAR_REF != 0 {
-                        let xr = p.x_ref[i] - p.x_ref[j];
-                        let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
-                        c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
-                    } else {
-                        0.0
-                    };
-                    // Heavily sheared material can bring two particles almost on top of
-                    // each other; 1/r² then makes the pair force stiff enough to blow the
-                    // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
-                    // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
-                    let rr = r.max(HG_MIN_SEPARATION_H * h);
-                    // Not the kernel sums' volumes: the stress stage has moved ρ since
-                    // (continuity), and both volumes must be the same step's.
-                    let cij = alpha * vol[i] * vol[j] * pair.w / (rr * rr);
-                    hourglass = e * (cij * 0.5 * (stiff + visc));
-                }
-                *out = PairForce { stress, hourglass };
+                *out = pair_force(i, j, pair, bits, &c);
             }
         });
     let shared = &*shared;
     let gather = |i: usize| {
         if !is_active(i) {
-            return ParticleForce {
-                acc: if moving(i) { g } else { Vector::zeros() },
-                hourglass_work: 0.0,
-            };
+            return finish(i, Vector::zeros(), Vector::zeros());
         }
-        let vi = p.vel[i];
         let mut a = Vector::zeros();
         let mut fhg = Vector::zeros();
         for &Side { j, id } in cache.of(nl, i) {
@@ -154,15 +204,9 @@ pub(crate) fn forces(
             a += stress * p.mass[j as usize];
             fhg -= hourglass;
         }
-        let acc = a + fhg / p.mass[i] + g;
-        ParticleForce {
-            acc,
-            hourglass_work: fhg.dot(&vi) * dt,
-        }
+        finish(i, a, fhg)
     };
     // Written in place; the work is then summed in particle order, whatever the threads.
-    let n = p.len();
-    accel.resize(n, Vector::zeros());
     let mut work = vec![0.0; n];
     accel
         .par_iter_mut()

@@ -23,6 +23,18 @@ pub(crate) struct KernelSums {
     /// Velocity gradients ∇v_i (eq. 15, corrected by L_i of eq. 7); zero for rigid particles and
     /// fragments.
     pub gradv: Vec<Matrix>,
+    /// Scratch of the one-thread scatter.
+    pub acc: Vec<Acc>,
+}
+
+/// One particle's running kernel sums in the one-thread scatter (`scatter_sums`), together so
+/// that a pair's partner is one cache line away.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Acc {
+    g: f64,
+    m: Matrix,
+    gv: Matrix,
+    count: u32,
 }
 
 /// One particle's kernel sums, before they are stored.
@@ -93,8 +105,12 @@ pub(crate) fn kernel_sums(ctx: &StepCtx<'_>, cache: &mut PairCache, sums: &mut K
             pairs: cnt as u32,
         }
     };
-    // Each particle's results go straight to their places, block by block.
     let n = p.len();
+    if rayon::current_num_threads() == 1 {
+        scatter_sums(ctx, cache, sums);
+        return;
+    }
+    // Each particle's results go straight to their places, block by block.
     sums.shepard.resize(n, 0.0);
     sums.lcorr.resize(n, Matrix::zeros());
     sums.gradv.resize(n, Matrix::zeros());
@@ -114,6 +130,82 @@ pub(crate) fn kernel_sums(ctx: &StepCtx<'_>, cache: &mut PairCache, sums: &mut K
                 (shepard[k], lcorr[k], gradv[k], count[k]) = (o.shepard, o.lcorr, o.gradv, o.pairs);
             }
         });
+}
+
+/// The kernel sums of `kernel_sums` on one thread: each pair is read once, in id order, and its
+/// terms go to both particles. The moment and velocity-gradient products are the same at both
+/// ends (x_ji = −x_ij and v_i − v_j = −(v_j − v_i) exactly, so the signs cancel bit for bit),
+/// so they are formed once and scaled by each end's partner volume. Particle i receives its
+/// terms from the rows of its lower partners, in increasing index, before those of its own row:
+/// its row's order, so every sum is bitwise the gather's and the bits are the same on any
+/// number of threads. The rows of used pairs (`PairCache::sides`) are not written: the forces
+/// scatter on one thread too and do not read them.
+fn scatter_sums(ctx: &StepCtx<'_>, cache: &mut PairCache, sums: &mut KernelSums) {
+    let SphView { p, nl, k, bc } = ctx.sph();
+    let hi = ctx.half;
+    let w0 = k.w(0.0);
+    let n = p.len();
+    let vol = &sums.vol;
+    let deformable = |i: usize| bc[p.body[i] as usize].deformable;
+    let acc = &mut sums.acc;
+    acc.clear();
+    acc.extend((0..n).map(|i| Acc {
+        g: vol[i] * w0,
+        m: Matrix::zeros(),
+        gv: Matrix::zeros(),
+        count: 0,
+    }));
+    let (half, flags) = (&cache.half, &cache.flags);
+    sums.shepard.resize(n, 0.0);
+    sums.lcorr.resize(n, Matrix::zeros());
+    sums.gradv.resize(n, Matrix::zeros());
+    cache.count.resize(n, 0);
+    for i in 0..n {
+        if !deformable(i) {
+            (
+                sums.shepard[i],
+                sums.lcorr[i],
+                sums.gradv[i],
+                cache.count[i],
+            ) = (1.0, Matrix::identity(), Matrix::zeros(), 0);
+            continue;
+        }
+        let (vi, voli) = (p.vel[i], vol[i]);
+        let mut own = acc[i];
+        let at = hi.start[i] as usize;
+        let pairs = half[at..].iter().zip(&flags[at..]);
+        for (&j, (pair, &bits)) in hi.upper_of(nl, i).iter().zip(pairs) {
+            if bits & USED == 0 {
+                continue;
+            }
+            let j = j as usize;
+            let vj = vol[j];
+            let other = &mut acc[j];
+            own.g += vj * pair.w;
+            other.g += voli * pair.w;
+            if bits & APART != 0 {
+                let grad = pair.xij * pair.dw_r;
+                let moment = outer(-pair.xij, grad);
+                own.m += moment * vj;
+                other.m += moment * voli;
+                let rate = outer(p.vel[j] - vi, grad);
+                own.gv += rate * vj;
+                other.gv += rate * voli;
+            }
+            own.count += 1;
+            other.count += 1;
+        }
+        // Row i is done: its lower partners came before it, its upper ones now.
+        let lcorr = correction(own.m);
+        sums.shepard[i] = own.g;
+        sums.lcorr[i] = lcorr;
+        cache.count[i] = own.count;
+        sums.gradv[i] = if own.count < MIN_SUPPORT_NEIGHBOURS {
+            Matrix::zeros()
+        } else {
+            own.gv * lcorr.transpose()
+        };
+    }
 }
 
 /// Inverts the Bonet–Lok moment matrix (eq. 8); where a particle has too few neighbours for a

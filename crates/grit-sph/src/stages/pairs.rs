@@ -70,14 +70,16 @@ pub(crate) struct PairCache {
     /// Each pair's `USED`, `NEAR_REF` and `APART` bits, by id: a gather reads one byte to skip
     /// a pair out of the support instead of its record.
     pub flags: Vec<u8>,
-    /// Used pairs, laid out like the neighbour rows.
+    /// Used pairs, laid out like the neighbour rows; written by the kernel sums' gather (two or
+    /// more threads) for the forces' gather, left as they are on one thread, where both scatter.
     pub sides: Vec<Side>,
     /// Pairs used in each particle's row.
     pub count: Vec<u32>,
 }
 
 impl PairCache {
-    /// The used same-body pairs of particle `i` (filled by the kernel sums this step).
+    /// The used same-body pairs of particle `i` (filled by the kernel sums this step on two or
+    /// more threads).
     #[inline]
     pub fn of<'a>(&'a self, nl: &NeighbourLists, i: usize) -> &'a [Side] {
         let s = nl.start[i] as usize;

@@ -373,6 +373,7 @@ impl World {
             stages::ceiling(
                 &self.particles,
                 &self.nbrs.same,
+                &self.nbrs.half,
                 &sc.pairs,
                 &sc.sums.vol,
                 &self.kernel,
