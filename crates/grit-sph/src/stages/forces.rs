@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{row_blocks, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
+use super::pairs::{row_blocks, scatter, HalfPair, PairCache, Side, APART, NEAR_REF, USED};
 use super::{
     BodyConst, KernelSums, ParTasks, SphView, StepCtx, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS,
 };
@@ -132,29 +132,31 @@ pub(crate) fn forces(
     };
     let n = p.len();
     accel.resize(n, Vector::zeros());
-    if rayon::current_num_threads() == 1 {
+    if scatter() {
         // One thread: each pair's shared terms go straight to both particles, in id order.
         // Particle i gets them from its lower partners' rows, in increasing index, before its
         // own row's: its row's order, so every sum is bitwise the gather's below.
         let mut a = vec![Vector::zeros(); n];
         let mut fhg = vec![Vector::zeros(); n];
-        for i in (0..n).filter(|_| any_pairs) {
-            let at = hi.start[i] as usize;
-            let pairs = cache.half[at..].iter().zip(&cache.flags[at..]);
-            let c = bc[p.body[i] as usize];
-            for (&j, (pair, &bits)) in hi.upper_of(nl, i).iter().zip(pairs) {
-                let j = j as usize;
-                if bits & USED == 0 || !(active[i] || active[j]) {
-                    continue;
-                }
-                let f = pair_force(i, j, pair, bits, &c);
-                if active[i] {
-                    a[i] += f.stress * p.mass[j];
-                    fhg[i] -= f.hourglass;
-                }
-                if active[j] {
-                    a[j] += -f.stress * p.mass[i];
-                    fhg[j] -= -f.hourglass;
+        if any_pairs {
+            for i in 0..n {
+                let at = hi.start[i] as usize;
+                let pairs = cache.half[at..].iter().zip(&cache.flags[at..]);
+                let c = bc[p.body[i] as usize];
+                for (&j, (pair, &bits)) in hi.upper_of(nl, i).iter().zip(pairs) {
+                    let j = j as usize;
+                    if bits & USED == 0 || !(active[i] || active[j]) {
+                        continue;
+                    }
+                    let f = pair_force(i, j, pair, bits, &c);
+                    if active[i] {
+                        a[i] += f.stress * p.mass[j];
+                        fhg[i] -= f.hourglass;
+                    }
+                    if active[j] {
+                        a[j] += -f.stress * p.mass[i];
+                        fhg[j] -= -f.hourglass;
+                    }
                 }
             }
         }

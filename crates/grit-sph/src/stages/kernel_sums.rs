@@ -6,7 +6,9 @@
 
 use rayon::prelude::*;
 
-use super::pairs::{fill_half_pairs, row_blocks, PairCache, Side, APART, ROWS_PER_BLOCK, USED};
+use super::pairs::{
+    fill_half_pairs, row_blocks, scatter, PairCache, Side, APART, ROWS_PER_BLOCK, USED,
+};
 use super::{SphView, StepCtx, MIN_SUPPORT_NEIGHBOURS};
 use crate::math::{outer, Matrix};
 
@@ -106,7 +108,7 @@ pub(crate) fn kernel_sums(ctx: &StepCtx<'_>, cache: &mut PairCache, sums: &mut K
         }
     };
     let n = p.len();
-    if rayon::current_num_threads() == 1 {
+    if scatter() {
         scatter_sums(ctx, cache, sums);
         return;
     }

@@ -87,6 +87,14 @@ impl PairCache {
     }
 }
 
+/// Whether this step's pair loops scatter each half pair to both particles (one thread) rather
+/// than gather each particle's row (two or more). The kernel sums and the forces must agree:
+/// the kernel sums' scatter leaves `PairCache::sides` unwritten, and only the forces' gather
+/// reads them.
+pub(crate) fn scatter() -> bool {
+    rayon::current_num_threads() == 1
+}
+
 /// `buf` cut into one mutable slice per row, row i of length `start[i + 1] − start[i]`, so the
 /// rows fill in parallel, each by its own owner; `buf` grows as for `row_blocks`, whose blocks
 /// it cuts on the calling thread (for the neighbour rebuild, where one serial pass per rebuild
