@@ -65,8 +65,9 @@ impl Kernel {
         self.w_dw(r).0
     }
 
-    /// W(r) and dW/dr together (dW/dr in 1/m³); shares the powers of (3 − q).
-    #[inline]
+    /// W(r) and dW/dr together (dW/dr in 1/m³); shares the powers of (3 − q). Always inlined:
+    /// the pair loops call it once per pair, and inlined its `match` on the kind leaves them.
+    #[inline(always)]
     pub fn w_dw(&self, r: f64) -> (f64, f64) {
         let q = r * self.inv_h;
         match self.kind {

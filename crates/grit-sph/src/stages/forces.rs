@@ -8,8 +8,9 @@ use super::pairs::{row_blocks, scatter, HalfPair, PairCache, Side, APART, NEAR_R
 use super::{
     BodyConst, KernelSums, ParTasks, SphView, StepCtx, HG_MIN_SEPARATION_H, MIN_SUPPORT_NEIGHBOURS,
 };
+use crate::fluid::ArtificialViscosity;
 use crate::math::{Matrix, Vector};
-use crate::particles::KINEMATIC;
+use crate::particles::{Particles, KINEMATIC};
 
 /// One particle's acceleration and the work of its hourglass force over the step.
 struct ParticleForce {
@@ -25,6 +26,73 @@ struct ParticleForce {
 pub(crate) struct PairForce {
     stress: Vector,
     hourglass: Vector,
+}
+
+/// What the pair terms of eqs. 6 and 16 read, so that one method forms them for the scatter
+/// and the gather alike and is inlined into both pair loops (as a closure it was called once
+/// per pair, reloading every captured slice).
+struct PairTerms<'a> {
+    p: &'a Particles,
+    /// σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
+    sig: &'a [Matrix],
+    gv: &'a [Matrix],
+    vol: &'a [f64],
+    alpha: f64,
+    av: Option<&'a ArtificialViscosity>,
+    h: f64,
+}
+
+impl PairTerms<'_> {
+    /// The terms pair (i, j), i < j, shares between its particles (`PairForce`); c is the
+    /// body's.
+    #[inline(always)]
+    fn of(&self, i: usize, j: usize, pair: &HalfPair, bits: u8, c: &BodyConst) -> PairForce {
+        let PairTerms {
+            p,
+            sig,
+            gv,
+            vol,
+            alpha,
+            av,
+            h,
+        } = *self;
+        if bits & APART == 0 {
+            return PairForce::default();
+        }
+        let HalfPair { xij, dw_r, .. } = *pair;
+        let mut stress = (sig[i] + sig[j]) * (xij * dw_r);
+        if let Some(av) = av {
+            let (vij, rho_mean) = (p.vel[i] - p.vel[j], 0.5 * (p.rho[i] + p.rho[j]));
+            stress -= xij * (dw_r * av.pi_ab(xij, vij, c.sound, rho_mean, h));
+        }
+        let mut hourglass = Vector::zeros();
+        if alpha > 0.0 && pair.w > 0.0 {
+            let r = pair.r();
+            let e = xij / r;
+            // Viscous part: velocity error against the mean velocity gradient.
+            let vij = p.vel[i] - p.vel[j];
+            let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
+            let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
+            // Stiffness part: separation error against the mean deformation gradient.
+            let stiff = if bits & NEAR_REF != 0 {
+                let xr = p.x_ref[i] - p.x_ref[j];
+                let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
+                c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
+            } else {
+                0.0
+            };
+            // Heavily sheared material can bring two particles almost on top of each other;
+            // 1/r² then makes the pair force stiff enough to blow the explicit step up (seen
+            // at 75°, impact 70). Below 0.4 h the weight stops growing; lattice neighbours
+            // (r ≈ 0.77 h) are untouched.
+            let rr = r.max(HG_MIN_SEPARATION_H * h);
+            // Not the kernel sums' volumes: the stress stage has moved ρ since (continuity),
+            // and both volumes must be the same step's.
+            let cij = alpha * vol[i] * vol[j] * pair.w / (rr * rr);
+            hourglass = e * (cij * 0.5 * (stiff + visc));
+        }
+        PairForce { stress, hourglass }
+    }
 }
 
 /// Accelerations from the stress divergence with the normalised gradient (eq. 6, 9, with the
@@ -77,45 +145,14 @@ pub(crate) fn forces(
     } else {
         Vec::new()
     };
-    let hourglass_on = |pair: &HalfPair| alpha > 0.0 && pair.w > 0.0;
-    // The terms pair (i, j), i < j, shares between its particles (`PairForce`); c is the body's.
-    let pair_force = |i: usize, j: usize, pair: &HalfPair, bits: u8, c: &BodyConst| {
-        if bits & APART == 0 {
-            return PairForce::default();
-        }
-        let HalfPair { xij, dw_r, .. } = *pair;
-        let mut stress = (sig[i] + sig[j]) * (xij * dw_r);
-        if let Some(av) = &av {
-            let (vij, rho_mean) = (p.vel[i] - p.vel[j], 0.5 * (p.rho[i] + p.rho[j]));
-            stress -= xij * (dw_r * av.pi_ab(xij, vij, c.sound, rho_mean, h));
-        }
-        let mut hourglass = Vector::zeros();
-        if hourglass_on(pair) {
-            let r = pair.r();
-            let e = xij / r;
-            // Viscous part: velocity error against the mean velocity gradient.
-            let vij = p.vel[i] - p.vel[j];
-            let dv = (vij - (gv[i] + gv[j]) * xij * 0.5).dot(&e);
-            let visc = 0.5 * (p.rho[i] + p.rho[j]) * c.sound * h * dv;
-            // Stiffness part: separation error against the mean deformation gradient.
-            let stiff = if bits & NEAR_REF != 0 {
-                let xr = p.x_ref[i] - p.x_ref[j];
-                let ds = (xij - (p.def_grad[i] + p.def_grad[j]) * xr * 0.5).dot(&e);
-                c.youngs * ds.clamp(-0.5 * r, 0.5 * r)
-            } else {
-                0.0
-            };
-            // Heavily sheared material can bring two particles almost on top of
-            // each other; 1/r² then makes the pair force stiff enough to blow the
-            // explicit step up (seen at 75°, impact 70). Below 0.4 h the weight stops
-            // growing; lattice neighbours (r ≈ 0.77 h) are untouched.
-            let rr = r.max(HG_MIN_SEPARATION_H * h);
-            // Not the kernel sums' volumes: the stress stage has moved ρ since
-            // (continuity), and both volumes must be the same step's.
-            let cij = alpha * vol[i] * vol[j] * pair.w / (rr * rr);
-            hourglass = e * (cij * 0.5 * (stiff + visc));
-        }
-        PairForce { stress, hourglass }
+    let terms = PairTerms {
+        p,
+        sig: &sig,
+        gv,
+        vol,
+        alpha,
+        av: av.as_ref(),
+        h,
     };
     // The particle's acceleration from its pair sums a (stress) and fhg (hourglass force).
     let finish = |i: usize, a: Vector, fhg: Vector| {
@@ -148,7 +185,7 @@ pub(crate) fn forces(
                     if bits & USED == 0 || !(active[i] || active[j]) {
                         continue;
                     }
-                    let f = pair_force(i, j, pair, bits, &c);
+                    let f = terms.of(i, j, pair, bits, &c);
                     if active[i] {
                         a[i] += f.stress * p.mass[j];
                         fhg[i] -= f.hourglass;
@@ -186,7 +223,7 @@ pub(crate) fn forces(
                 if bits & USED == 0 || !(active[i] || active[j]) {
                     continue;
                 }
-                *out = pair_force(i, j, pair, bits, &c);
+                *out = terms.of(i, j, pair, bits, &c);
             }
         });
     let shared = &*shared;
