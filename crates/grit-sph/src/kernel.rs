@@ -66,7 +66,7 @@ impl Kernel {
     }
 
     /// W(r) and dW/dr together (dW/dr in 1/m³); shares the powers of (3 − q). Always inlined:
-    /// the pair loops call it once per pair, and inlined its `match` on the kind leaves them.
+    /// the pair loops call it once per pair, where a call costs more than its arithmetic.
     #[inline(always)]
     pub fn w_dw(&self, r: f64) -> (f64, f64) {
         let q = r * self.inv_h;

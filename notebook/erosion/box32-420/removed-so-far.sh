@@ -4,6 +4,8 @@
 # with the run, and the next session's keeper starts from the checkpoints the save restores,
 # so the files of successive sessions join into one table (drop repeated rows).
 #   removed-so-far.sh KEEP_DIR OUT.tsv.xz     (KEEP_DIR: /work/runs/box32/keep/big)
+# SP names the surface_profile example (`cargo build --release -p grit-erosion --example
+# surface_profile`; the default is session 46's native build).
 set -euo pipefail
 keep=$1 out=$2
 sp=${SP:-/work/target-native/release/examples/surface_profile}

@@ -29,8 +29,8 @@ pub(crate) struct PairForce {
 }
 
 /// What the pair terms of eqs. 6 and 16 read, so that one method forms them for the scatter
-/// and the gather alike and is inlined into both pair loops (as a closure it was called once
-/// per pair, reloading every captured slice).
+/// and the gather alike, inlined into both pair loops: a closure there is compiled as a call
+/// per pair that reloads every captured slice.
 struct PairTerms<'a> {
     p: &'a Particles,
     /// σ_i / (ρ_i² Γ_i): the factor of eq. 6 with eq. 9's normalisation.
