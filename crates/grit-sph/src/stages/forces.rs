@@ -29,7 +29,7 @@ pub(crate) struct PairForce {
 }
 
 /// What a pair's terms of eqs. 6 and 16 read of each of its particles, in one record: the pair
-/// loops reach each partner through one record of three cache lines instead of seven arrays.
+/// loops reach each partner through one 152-byte record instead of eight arrays.
 #[derive(Debug, Clone, Copy, Default)]
 struct Partner {
     /// σ / (ρ² Γ): the factor of eq. 6 with eq. 9's normalisation.
@@ -49,7 +49,7 @@ struct Partner {
 /// and the gather alike, inlined into both pair loops: a closure there is compiled as a call
 /// per pair that reloads every captured slice.
 struct PairTerms<'a> {
-    side: &'a [Partner],
+    partners: &'a [Partner],
     alpha: f64,
     av: Option<&'a ArtificialViscosity>,
     h: f64,
@@ -60,11 +60,16 @@ impl PairTerms<'_> {
     /// body's.
     #[inline(always)]
     fn of(&self, i: usize, j: usize, pair: &HalfPair, bits: u8, c: &BodyConst) -> PairForce {
-        let PairTerms { side, alpha, av, h } = *self;
+        let PairTerms {
+            partners,
+            alpha,
+            av,
+            h,
+        } = *self;
         if bits & APART == 0 {
             return PairForce::default();
         }
-        let (a, b) = (&side[i], &side[j]);
+        let (a, b) = (&partners[i], &partners[j]);
         let HalfPair { xij, dw_r, .. } = *pair;
         let mut stress = (a.sig + b.sig) * (xij * dw_r);
         if let Some(av) = av {
@@ -123,7 +128,7 @@ pub(crate) fn forces(
     let av = settings.solid_viscosity;
     let g = settings.gravity_m_s2;
     let h = k.h;
-    let side: Vec<Partner> = (0..p.len())
+    let partners: Vec<Partner> = (0..p.len())
         .into_par_iter()
         .par_tasks()
         .map(|i| {
@@ -162,7 +167,7 @@ pub(crate) fn forces(
         Vec::new()
     };
     let terms = PairTerms {
-        side: &side,
+        partners: &partners,
         alpha,
         av: av.as_ref(),
         h,
@@ -200,11 +205,11 @@ pub(crate) fn forces(
                     }
                     let f = terms.of(i, j, pair, bits, &c);
                     if active[i] {
-                        a[i] += f.stress * side[j].mass;
+                        a[i] += f.stress * partners[j].mass;
                         fhg[i] -= f.hourglass;
                     }
                     if active[j] {
-                        a[j] += -f.stress * side[i].mass;
+                        a[j] += -f.stress * partners[i].mass;
                         fhg[j] -= -f.hourglass;
                     }
                 }
