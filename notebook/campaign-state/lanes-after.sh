@@ -30,7 +30,8 @@ last_job() {
 case "${2:-}" in
   b-now) ;;
   b-last) last_job ;;
-  *) wait_big ;;
+  '') wait_big ;;
+  *) echo "lanes-after.sh: unknown mode '$2' (b-now, b-last or none)" >&2; exit 2 ;;
 esac
 (if [ -n "${2:-}" ]; then wait_big; fi
  run ppd48 examples/resolution48-steady.json "$R/ppd48" --workers 1
