@@ -48,21 +48,33 @@ fn hardening(jc: &JohnsonCook, eps_p: f64) -> f64 {
 #[inline]
 fn yield_softened(jc: &JohnsonCook, eps_p: f64, rate: f64, th: f64) -> (f64, f64, f64) {
     let hard = hardening(jc, eps_p);
-    let dhard = if eps_p > 0.0 {
-        jc.b_pa * jc.n * pow(eps_p, jc.n - 1.0)
-    } else {
-        0.0
-    };
-    let (rate_term, drate) = if rate > jc.ref_strain_rate_s {
-        (1.0 + jc.c * ln(rate / jc.ref_strain_rate_s), jc.c / rate)
-    } else {
-        (1.0, 0.0)
-    };
+    let dhard = hardening_slope(jc, eps_p);
+    let (rate_term, drate) = rate_factor(jc, rate);
     (
         hard * rate_term * th,
         dhard * rate_term * th,
         hard * drate * th,
     )
+}
+
+/// d(A + B ε_p^n)/dε_p = n B ε_p^(n−1) of eq. 18, 0 at ε_p = 0.
+#[inline]
+fn hardening_slope(jc: &JohnsonCook, eps_p: f64) -> f64 {
+    if eps_p > 0.0 {
+        jc.b_pa * jc.n * pow(eps_p, jc.n - 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// The rate factor 1 + C ln(ε̇/ε̇0) of eq. 18 and its derivative in ε̇, held at (1, 0) below ε̇0.
+#[inline]
+fn rate_factor(jc: &JohnsonCook, rate: f64) -> (f64, f64) {
+    if rate > jc.ref_strain_rate_s {
+        (1.0 + jc.c * ln(rate / jc.ref_strain_rate_s), jc.c / rate)
+    } else {
+        (1.0, 0.0)
+    }
 }
 
 /// The zero-rate Johnson–Cook yield stress (eq. 18) at one plastic strain and temperature, with
@@ -79,12 +91,16 @@ pub struct YieldAt {
 /// `YieldAt` for plastic strain `eps_p` and temperature `t`.
 #[inline]
 pub fn yield_at(jc: &JohnsonCook, eps_p: f64, t: f64) -> YieldAt {
-    let th = thermal_softening(jc, t);
     // The elastic check needs the yield stress alone: no derivative, so no second power.
-    YieldAt {
-        sy0: hardening(jc, eps_p) * th,
-        th,
-    }
+    yield_hardened(jc, hardening(jc, eps_p), t)
+}
+
+/// `YieldAt` at temperature `t` for a plastic strain whose hardening A + B ε_p^n (eq. 18) is
+/// `hard` (`Plastic::hardening`), to the bits of `yield_at`.
+#[inline]
+pub fn yield_hardened(jc: &JohnsonCook, hard: f64, t: f64) -> YieldAt {
+    let th = thermal_softening(jc, t);
+    YieldAt { sy0: hard * th, th }
 }
 
 /// Result of the return mapping for one particle and one step.
@@ -96,6 +112,9 @@ pub struct Plastic {
     pub d_eps: f64,
     /// Yield stress at the end of the step (Pa).
     pub sigma_y: f64,
+    /// A + B (ε_p + Δε)^n where the iteration ended on the returned Δε: the next step's
+    /// `YieldAt` at the new ε_p needs no power of its own (`yield_hardened`).
+    pub hardening: Option<f64>,
 }
 
 /// J2 radial return (Wilkins; Simo & Hughes 1998, box 3.1): the trial deviator is scaled back to
@@ -132,31 +151,31 @@ pub fn radial_return_at(
             sdev: s_trial,
             d_eps: 0.0,
             sigma_y: sy0,
+            hardening: None,
         };
     }
     // f(Δε) = seq − 3GΔε − σy(Δε) is decreasing; bracket the root in [0, seq/3G].
-    let f = |de: f64| {
-        let (sy, dsde, dsdr) = yield_softened(jc, eps_p + de, de / dt, th);
-        (
-            seq - 3.0 * shear * de - sy,
-            -3.0 * shear - dsde - dsdr / dt,
-            sy,
-        )
-    };
     let (mut lo, mut hi) = (0.0, seq / (3.0 * shear));
     let mut de = 0.5 * (seq - sy0) / (3.0 * shear);
     let mut sy = sy0;
+    let mut ended = None;
     for _ in 0..60 {
-        let (fv, dfv, s) = f(de);
-        sy = s;
+        let e = eps_p + de;
+        let hard = hardening(jc, e);
+        let (rate_term, drate) = rate_factor(jc, de / dt);
+        sy = hard * rate_term * th;
+        let fv = seq - 3.0 * shear * de - sy;
         if fv > 0.0 {
             lo = de;
         } else {
             hi = de;
         }
         if fv.abs() <= 1e-12 * seq || hi - lo <= 1e-15 * hi {
+            ended = Some(hard);
             break;
         }
+        // The derivative's power only once the step goes on: the last iteration skips it.
+        let dfv = -3.0 * shear - hardening_slope(jc, e) * rate_term * th - hard * drate * th / dt;
         let newton = de - fv / dfv;
         de = if newton > lo && newton < hi && dfv < 0.0 {
             newton
@@ -169,6 +188,7 @@ pub fn radial_return_at(
         sdev: s_trial * scale,
         d_eps: de,
         sigma_y: sy,
+        hardening: ended,
     }
 }
 

@@ -51,6 +51,18 @@ impl YieldMemo {
         }
         self.at
     }
+
+    /// Keeps the particle's `YieldAt` at its new ε_p and T from the hardening the radial return
+    /// ended on, so the next step's `get` finds it and takes one power, not two.
+    #[inline]
+    fn set_hardened(&mut self, id: u32, jc: &JohnsonCook, eps_p: f64, temp: f64, hard: f64) {
+        *self = YieldMemo {
+            id,
+            eps_p: eps_p.to_bits(),
+            temp: temp.to_bits(),
+            at: physics::yield_hardened(jc, hard, temp),
+        };
+    }
 }
 
 /// Continuity (eq. 5 as ρ̇ = −ρ tr ∇v), Jaumann rate (eq. 13), radial return with Johnson–Cook
@@ -148,6 +160,9 @@ pub(crate) fn stress(ctx: &mut StepCtx<'_>, gv: &[Matrix], memo: &mut Vec<YieldM
                             }
                             *ep += r.d_eps;
                             *temp += beta * wp / (*rho * mat.heat_capacity_j_kgk);
+                            if let Some(hard) = r.hardening {
+                                memo.set_hardened(p.id[i], jc, *ep, *temp, hard);
+                            }
                             wp * m / *rho
                         } else {
                             0.0
