@@ -16,7 +16,14 @@ pub fn homologous_temperature(jc: &JohnsonCook, t: f64) -> f64 {
 /// logarithm never softens the material (docs/references.md#constitutive-forms).
 #[inline]
 pub fn jc_yield(jc: &JohnsonCook, eps_p: f64, rate: f64, t: f64) -> (f64, f64, f64) {
-    yield_softened(jc, eps_p, rate, thermal_softening(jc, t))
+    let th = thermal_softening(jc, t);
+    let hard = hardening(jc, eps_p);
+    let (rate_term, drate) = rate_factor(jc, rate);
+    (
+        hard * rate_term * th,
+        hardening_slope(jc, eps_p) * rate_term * th,
+        hard * drate * th,
+    )
 }
 
 /// The thermal factor 1 − T*^m of Johnson–Cook yield (eq. 18).
@@ -41,20 +48,6 @@ fn hardening(jc: &JohnsonCook, eps_p: f64) -> f64 {
     } else {
         jc.a_pa + jc.b_pa * pow(e, jc.n)
     }
-}
-
-/// `jc_yield` with its thermal factor `th` (`thermal_softening`) given: the radial return takes it
-/// once per particle, not once per iteration.
-#[inline]
-fn yield_softened(jc: &JohnsonCook, eps_p: f64, rate: f64, th: f64) -> (f64, f64, f64) {
-    let hard = hardening(jc, eps_p);
-    let dhard = hardening_slope(jc, eps_p);
-    let (rate_term, drate) = rate_factor(jc, rate);
-    (
-        hard * rate_term * th,
-        dhard * rate_term * th,
-        hard * drate * th,
-    )
 }
 
 /// d(A + B ε_p^n)/dε_p = n B ε_p^(n−1) of eq. 18, 0 at ε_p = 0.

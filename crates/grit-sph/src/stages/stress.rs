@@ -40,14 +40,8 @@ impl YieldMemo {
     /// memo needs no invalidation: a deletion, reordering or restored checkpoint only misses.
     #[inline]
     fn get(&mut self, id: u32, jc: &JohnsonCook, eps_p: f64, temp: f64) -> YieldAt {
-        let (e, t) = (eps_p.to_bits(), temp.to_bits());
-        if self.id != id || self.eps_p != e || self.temp != t {
-            *self = YieldMemo {
-                id,
-                eps_p: e,
-                temp: t,
-                at: physics::yield_at(jc, eps_p, temp),
-            };
+        if self.id != id || self.eps_p != eps_p.to_bits() || self.temp != temp.to_bits() {
+            self.keep(id, eps_p, temp, physics::yield_at(jc, eps_p, temp));
         }
         self.at
     }
@@ -56,11 +50,17 @@ impl YieldMemo {
     /// ended on, so the next step's `get` finds it and takes one power, not two.
     #[inline]
     fn set_hardened(&mut self, id: u32, jc: &JohnsonCook, eps_p: f64, temp: f64, hard: f64) {
+        self.keep(id, eps_p, temp, physics::yield_hardened(jc, hard, temp));
+    }
+
+    /// The memo of `at`, computed for particle `id` at these ε_p and T.
+    #[inline]
+    fn keep(&mut self, id: u32, eps_p: f64, temp: f64, at: YieldAt) {
         *self = YieldMemo {
             id,
             eps_p: eps_p.to_bits(),
             temp: temp.to_bits(),
-            at: physics::yield_hardened(jc, hard, temp),
+            at,
         };
     }
 }
