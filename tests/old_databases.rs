@@ -3,10 +3,12 @@
 //! 'jet') opens with today's binary, is migrated, and its campaign resumes from the stored
 //! units and checkpoints to the very bits an uninterrupted run of today's binary gives.
 //!
-//! The two databases in tests/data/schema5 were written by the binary of commit 58f8f9b
-//! (`grit run SPEC --out DIR --workers 1 --threads 1`, stopped with SIGINT part way): an
-//! impact campaign with one sample done and one released after 4 of 6 impacts with its
-//! checkpoint, and a jet campaign with one run done and one released after 2 of 4 slices.
+//! The two databases in tests/data/schema5 were written by the binary of commit 58f8f9b with
+//! today's radial return (7ee7c32's, which moved the engine's bits) put in operation for
+//! operation (`58f8f9b-radial-return-7ee7c32.diff` there): `grit run SPEC --out DIR --workers 1
+//! --threads 1`, stopped with SIGINT once the database held 10 impacts or 6 slices: an impact
+//! campaign with one sample done and one released after 4 of 6 impacts with its checkpoint, and
+//! a jet campaign with one run done and one released after 2 of 4 slices.
 
 use std::path::Path;
 
