@@ -1,13 +1,14 @@
-"""Compares the 16-per-Dg erosion of two engines on 25 samples at 45 and 90 degrees, per impact
-window: the old engine's samples are ppd16c's 15 (seed 2024, first N impacts) and
-newton-check-16-old's 10 (seed 2025); the new engine's are newton-check-16's 25 (seed 2024).
+"""Paired comparison of the 16-per-Dg erosion of the old engine (0a408d93d042d5e9) and the new
+one (the radial return in ln Δε) on the same 25 samples at 45 and 90 degrees, impacts 1..N.
 
-  python3 compare.py RUNS_DIR [N]     (RUNS_DIR holds ppd16c/, newton-old/, newton-new/)
+  python3 compare.py RUNS_DIR [N]
 
-Per sample: the least-squares slope of cumulative loss against cumulative grain mass over
-impacts N-19..N (the seed's rule), the same over N-59..N, the cumulative loss over 1..N and
-the damage added over 1..N, each per grain mass (mg/g). Per cell: mean, standard error, and
-the new-old difference in combined standard errors."""
+New engine: newton-new/grit.db (check-new.json, seed 2024). Old engine, the same job seeds:
+samples 0-14 from ppd16c/grit.db (resolution16-balanced.json, seed 2024), samples 15-24 from
+newton-pairs/old-cC-sS.json (pairs.sh). Per pair: whether every impact's mass loss is bitwise
+the same, the largest relative difference of an impact's damage added, and of its rebound
+ratio. Per cell and engine: the seed's slope over impacts N-19..N, cumulative loss and damage
+added over 1..N (mg per g of grain), mean and standard error over the samples present in both."""
 import json, math, sqlite3, sys
 
 runs = sys.argv[1]
@@ -15,32 +16,30 @@ N = int(sys.argv[2]) if len(sys.argv) > 2 else 200
 ANGLES = {0: 45, 1: 90}
 
 
-def samples(db, limit=None):
-    """{angle: [[(grain, loss, damage) per impact 1..N] per sample]}"""
+def from_db(db, cell, si):
     c = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
-    out = {45: [], 90: []}
-    jobs = c.execute("select id, cell_index, sample_index from jobs order by cell_index, sample_index")
-    for jid, cell, si in jobs.fetchall():
-        if limit is not None and si >= limit:
-            continue
-        rows = c.execute("select unit, record from units where job_id=? and unit<=? order by unit", (jid, N)).fetchall()
-        if len(rows) < N:
-            continue
-        seq = []
-        for u, rec in rows:
-            r = json.loads(rec)
-            seq.append((r["grain_mass_kg"], r["mass_loss_kg"], r["outcome"]["damage_added_kg"]))
-        out[ANGLES[cell]].append(seq)
-    return out
+    row = c.execute("select id from jobs where cell_index=? and sample_index=?", (cell, si)).fetchone()
+    if row is None:
+        return None
+    recs = [json.loads(r) for (r,) in c.execute(
+        "select record from units where job_id=? and unit<=? order by unit", (row[0], N))]
+    return recs if len(recs) == N else None
 
 
-def slope(seq, first, last):
-    """LSQ slope of cumulative loss on cumulative grain mass over impacts first..last (1-based)."""
+def from_json(path):
+    try:
+        recs = json.load(open(path))["impacts"][:N]
+    except FileNotFoundError:
+        return None
+    return recs if len(recs) == N else None
+
+
+def slope(recs, first, last):
     cg = cl = 0.0
     xs, ys = [], []
-    for k, (g, l, _) in enumerate(seq, 1):
-        cg += g
-        cl += l
+    for k, r in enumerate(recs, 1):
+        cg += r["grain_mass_kg"]
+        cl += r["mass_loss_kg"]
         if first <= k <= last:
             xs.append(cg)
             ys.append(cl)
@@ -48,29 +47,42 @@ def slope(seq, first, last):
     return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
 
 
-def stats(vals):
-    n = len(vals)
-    m = sum(vals) / n
-    sd = math.sqrt(sum((v - m) ** 2 for v in vals) / (n - 1))
-    return m, sd / math.sqrt(n), n
+def mean_se(v):
+    m = sum(v) / len(v)
+    return m, math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1) / len(v)) if len(v) > 1 else float("nan")
 
 
 measures = {
-    f"slope {N-19}-{N}": lambda s: 1e3 * slope(s, N - 19, N),
-    f"slope {N-59}-{N}": lambda s: 1e3 * slope(s, N - 59, N),
-    f"loss 1-{N}": lambda s: 1e3 * sum(x[1] for x in s) / sum(x[0] for x in s),
-    f"damage 1-{N}": lambda s: 1e3 * sum(x[2] for x in s) / sum(x[0] for x in s),
+    f"slope {N-19}-{N}": lambda r: 1e3 * slope(r, N - 19, N),
+    f"loss 1-{N}": lambda r: 1e3 * sum(x["mass_loss_kg"] for x in r) / sum(x["grain_mass_kg"] for x in r),
+    f"damage 1-{N}": lambda r: 1e3 * sum(x["outcome"]["damage_added_kg"] for x in r) / sum(x["grain_mass_kg"] for x in r),
 }
-old = samples(f"{runs}/ppd16c/grit.db", limit=15)
-extra = samples(f"{runs}/newton-old/grit.db")
-new = samples(f"{runs}/newton-new/grit.db")
-print(f"| angle | measure (mg/g) | old engine (0a408d93) | new engine | new − old | in combined s.e. |")
-print("|---|---|---|---|---|---|")
-for a in (45, 90):
-    o = old[a] + extra[a]
+print("| angle | pairs | impacts with bitwise equal loss | largest relative difference of damage added / rebound |")
+print("|---|---|---|---|")
+cells = {}
+for cell, angle in ANGLES.items():
+    pairs = []
+    for si in range(25):
+        new = from_db(f"{runs}/newton-new/grit.db", cell, si)
+        old = from_db(f"{runs}/ppd16c/grit.db", cell, si) if si < 15 else \
+            from_json(f"{runs}/newton-pairs/old-c{cell}-s{si}.json")
+        if new is not None and old is not None:
+            pairs.append((si, old, new))
+    same = sum(o["mass_loss_kg"] == n["mass_loss_kg"] for _, old, new in pairs for o, n in zip(old, new))
+    dd = max((abs(o["outcome"]["damage_added_kg"] - n["outcome"]["damage_added_kg"]) / o["outcome"]["damage_added_kg"]
+              for _, old, new in pairs for o, n in zip(old, new) if o["outcome"]["damage_added_kg"]), default=0)
+    dr = max((abs(o["outcome"]["rebound_ratio"] - n["outcome"]["rebound_ratio"]) / abs(o["outcome"]["rebound_ratio"])
+              for _, old, new in pairs for o, n in zip(old, new) if o["outcome"]["rebound_ratio"]), default=0)
+    print(f"| {angle}° | {len(pairs)} | {same} of {N * len(pairs)} | {dd:.1e} / {dr:.1e} |")
+    cells[angle] = pairs
+print()
+print("| angle | measure (mg/g) | old engine | new engine | new − old, paired |")
+print("|---|---|---|---|---|")
+for angle, pairs in cells.items():
+    if len(pairs) < 2:
+        continue
     for name, f in measures.items():
-        mo, so, no = stats([f(s) for s in o])
-        mn, sn, nn = stats([f(s) for s in new[a]])
-        d = mn - mo
-        z = d / math.hypot(so, sn)
-        print(f"| {a}° | {name} | {mo:.3f} ± {so:.3f} (n={no}) | {mn:.3f} ± {sn:.3f} (n={nn}) | {d:+.3f} ({100*d/mo:+.1f} %) | {z:+.2f} |")
+        o = [f(old) for _, old, _ in pairs]
+        n = [f(new) for _, _, new in pairs]
+        (mo, so), (mn, sn), (md, sd) = mean_se(o), mean_se(n), mean_se([b - a for a, b in zip(o, n)])
+        print(f"| {angle}° | {name} | {mo:.4f} ± {so:.4f} | {mn:.4f} ± {sn:.4f} | {md:+.1e} ± {sd:.1e} |")
