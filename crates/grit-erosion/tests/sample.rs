@@ -121,12 +121,11 @@ fn checkpoint_of_another_job_or_garbage_is_refused() {
 }
 
 #[test]
-fn a_version_7_checkpoint_from_the_campaigns_binary_resumes_with_its_bits() {
+fn a_version_7_checkpoint_from_the_campaigns_binary_resumes_to_todays_bits() {
     // Written by the farm of commit deb87e0 (10 per Dg, 45°, seed 3, 72 impacts), whose
-    // records postcard laid out without `damage_added_kg`. Impact 73 is today's engine's, from
-    // `grit sample --resume` of 7ee7c32 (deb87e0's own had rebound 0.5064199013719218, before
-    // the radial return in ln Δε moved the last bits): the library resuming the old layout
-    // gives the command line's bits.
+    // records postcard laid out without `damage_added_kg`. Impact 73 is what today's engine
+    // gives from it by `grit sample --resume`: the library resuming the old layout gives the
+    // command line's bits.
     let bytes = include_bytes!("data/checkpoint-v7.ckpt");
     let mut s = Sample::from_checkpoint(bytes).unwrap();
     assert_eq!(s.records().len(), 72);
