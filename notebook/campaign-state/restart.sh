@@ -1,0 +1,62 @@
+#!/bin/bash
+# Brings the long campaigns back on a new machine, as the sessions' notes did by hand: builds the
+# pinned binary (5604815 built for the CPU and guided by the profile kept in
+# notebook/performance/pgo-2026-12-06/) unless it is there, refuses it unless it computes the
+# campaigns' bits, restores each named campaign from this folder's saves unless its run folder
+# exists, then starts one lane per argument (then.sh), the checkpoint keeper and save-every.sh.
+#   bash notebook/campaign-state/restart.sh [--no-start] SESSION LANE...   (from the repository's root)
+# LANE: campaign names run one after another in one lane, joined by commas (ppd48, or
+# ppd24b,paper). SESSION names save-every.sh's files (e.g. s53). --no-start stops after the
+# restore (R may name a scratch folder for a trial).
+set -euo pipefail
+start=1
+if [ "${1:-}" = "--no-start" ]; then start=0; shift; fi
+[ $# -ge 2 ] || { echo "usage: restart.sh [--no-start] SESSION LANE..." >&2; exit 2; }
+session=$1; shift
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+B=${B:-/work/bins/grit-5604815-native-pgo}
+R=${R:-/work/runs}
+commit=5604815
+if [ ! -x "$B" ]; then
+  echo "$(date -u +%FT%TZ) building $B (about 6 minutes on an idle machine)"
+  mkdir -p "$(dirname "$B")" /work/pgo
+  xz -dc "$repo/notebook/performance/pgo-2026-12-06/grit.profdata.xz" > /work/pgo/grit.profdata
+  [ -d /work/cand ] || git -C "$repo" worktree add /work/cand "$commit"
+  (cd /work/cand && RUSTFLAGS="-C target-cpu=native -Cprofile-use=/work/pgo/grit.profdata" \
+    CARGO_TARGET_DIR=/work/target-pgo-use cargo build --release --bin grit)
+  cp /work/target-pgo-use/release/grit "$B"
+fi
+# The campaigns' bits: the engine fingerprints and the two 3-impact samples' md5s.
+v=$("$B" version)
+for f in 0a408d93d042d5e9 d0bf534f1dd852f9; do
+  grep -q "$f" <<< "$v" || { echo "restart.sh: $B lacks fingerprint $f:"$'\n'"$v" >&2; exit 1; }
+done
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+for want in 45:74caabe3743c6901ba7e418413522ec2 90:8e58805186dcdf9ab6880fca705c687a; do
+  a=${want%%:*}
+  "$B" sample --angle "$a" --impacts 3 --seed 3 --threads 1 --json -o "$tmp/s$a.json" > /dev/null 2>&1
+  got=$(md5sum < "$tmp/s$a.json" | cut -c1-32)
+  [ "$got" = "${want#*:}" ] || { echo "restart.sh: $a° sample md5 $got, not ${want#*:}" >&2; exit 1; }
+done
+echo "$B computes the campaigns' bits"
+mkdir -p "$R"
+for lane in "$@"; do
+  for name in ${lane//,/ }; do
+    if [ -e "$R/$name/grit.db" ]; then
+      echo "$name: $R/$name/grit.db exists, not restored"
+    else
+      bash "$here/restore.sh" "$here/$name.sql" "$R/$name"
+    fi
+  done
+done
+[ "$start" = 1 ] || exit 0
+cd "$repo"
+for lane in "$@"; do
+  B=$B R=$R setsid nohup bash "$here/then.sh" 0 ${lane//,/ } > /dev/null 2>&1 < /dev/null &
+done
+setsid nohup bash "$repo/notebook/erosion/walls-2026-11-29/keep-fast.sh" > /dev/null 2>&1 < /dev/null &
+RUNS=$R setsid nohup bash "$here/save-every.sh" 2700 "$session" >> "$R/save-every.log" 2>&1 < /dev/null &
+sleep 5
+pgrep -af "then.sh|keep-fast|save-every|$(basename "$B") run" || true
