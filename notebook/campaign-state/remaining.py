@@ -16,7 +16,7 @@ impacts not yet run are extrapolated per cell by a straight line through its las
 mean steps (the crater deepens steadily, so the steps grow with the impact number); a cell with
 fewer than 40 impacts takes the mean of the campaign's other cells' lines. Cells whose jobs are
 all done are final and left out. Prints each open cell's impacts to go and CPU-hours, and the
-total.
+total, and each open cell's steps and CPU-s per impact at its furthest sample (the line's value).
 """
 import sqlite3
 import statistics
@@ -60,9 +60,8 @@ for cell, unit, st in con.execute(
 
 def line(cell):
     """Least-squares line of mean steps against impact number over the cell's last 120."""
-    units = sorted(steps[cell])[-120:]
-    xs = units
-    ys = [statistics.mean(steps[cell][u]) for u in units]
+    xs = sorted(steps[cell])[-120:]
+    ys = [statistics.mean(steps[cell][u]) for u in xs]
     mx, my = statistics.mean(xs), statistics.mean(ys)
     sxx = sum((x - mx) ** 2 for x in xs)
     slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx else 0.0
@@ -73,24 +72,24 @@ cells = con.execute(
     "select cell_index, count(*), group_concat(units_done), min(state = 'done') "
     "from jobs group by cell_index order by cell_index"
 ).fetchall()
-grown = [c for c in steps if len(steps[c]) >= 40]
+lines = {c: line(c) for c in steps if len(steps[c]) >= 40}
 total = 0.0
 print(f"CPU per step: {s_step * 1000:.2f} ms " + ("(given)" if given else f"(median of {len(per_step)} impacts)"))
-print("cell  samples  done per sample  impacts to go  CPU-h")
+print("cell  samples  done per sample  steps, CPU-s per impact now  impacts to go  CPU-h")
 for cell, n, done, finished in cells:
     if finished:
         continue  # every job done: the cell is final (a cell to grow is extended at once)
     done = [int(d) for d in done.split(",")]
     go = sum(max(end - d, 0) for d in done)
-    if cell in grown:
-        f = line(cell)
-        cost = sum(f(u) for d in done for u in range(d + 1, end + 1))
-    elif grown:
-        fs = [line(c) for c in grown]
-        cost = sum(statistics.mean(g(u) for g in fs) for d in done for u in range(d + 1, end + 1))
+    if cell in lines:
+        f = lines[cell]
+    elif lines:
+        f = lambda u: statistics.mean(g(u) for g in lines.values())  # noqa: E731
     else:
         sys.exit("remaining.py: no cell has 40 impacts to extrapolate from")
+    now = f(max(done))
+    cost = sum(f(u) for d in done for u in range(d + 1, end + 1))
     hours = cost * s_step / 3600
     total += hours
-    print(f"{cell:4}  {n:7}  {min(done)}-{max(done):<12}  {go:13}  {hours:5.1f}")
+    print(f"{cell:4}  {n:7}  {min(done)}-{max(done):<14}  {now:6.0f}, {now * s_step:5.1f}{'':16}  {go:13}  {hours:5.1f}")
 print(f"total {total:.1f} CPU-hours to {end} impacts per sample")

@@ -7,7 +7,8 @@
 #   bash notebook/campaign-state/restart.sh [--no-start] SESSION LANE...   (from the repository's root)
 # LANE: campaign names run one after another in one lane, joined by commas (ppd48, or
 # ppd24b,paper). SESSION names save-every.sh's files (e.g. s53). --no-start stops after the
-# restore (R may name a scratch folder for a trial).
+# restore (R may name a scratch folder for a trial; keep-fast.sh watches /work/runs alone, so the
+# lanes are started only with the default R).
 set -euo pipefail
 start=1
 if [ "${1:-}" = "--no-start" ]; then start=0; shift; fi
@@ -52,6 +53,7 @@ for lane in "$@"; do
   done
 done
 [ "$start" = 1 ] || exit 0
+[ "$R" = /work/runs ] || { echo "restart.sh: lanes start only in /work/runs (keep-fast.sh)" >&2; exit 2; }
 cd "$repo"
 for lane in "$@"; do
   B=$B R=$R setsid nohup bash "$here/then.sh" 0 ${lane//,/ } > /dev/null 2>&1 < /dev/null &
