@@ -1,8 +1,9 @@
 #!/bin/bash
 # Brings the long campaigns back on a new machine, as the sessions' notes did by hand: builds the
-# pinned binary (5604815 built for the CPU and guided by the profile kept in
-# notebook/performance/pgo-2026-12-06/) unless it is there, refuses it unless it computes the
-# campaigns' bits, restores each named campaign from this folder's saves unless its run folder
+# pinned binary (5604815 with the certified radial return of
+# notebook/performance/certified-return-2026-12-07/, built for the CPU and guided by the profile
+# kept in notebook/performance/pgo-2026-12-06/) unless it is there, refuses it unless it computes
+# the campaigns' bits, restores each named campaign from this folder's saves unless its run folder
 # exists, then starts one lane per argument (then.sh), the checkpoint keeper and save-every.sh.
 #   bash notebook/campaign-state/restart.sh [--no-start] SESSION LANE...   (from the repository's root)
 # LANE: campaign names run one after another in one lane, joined by commas (ppd48, or
@@ -16,17 +17,26 @@ if [ "${1:-}" = "--no-start" ]; then start=0; shift; fi
 session=$1; shift
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
-B=${B:-/work/bins/grit-5604815-native-pgo}
+B=${B:-/work/bins/grit-5604815-cert-native-pgo}
 R=${R:-/work/runs}
 commit=5604815
+# The patch applied with its own author as committer and date gives this commit on any machine.
+patched=25136284cf4e04050332c34ca1d2f5dc0efb4498
+patch=$repo/notebook/performance/certified-return-2026-12-07/certified-return.patch
 if [ ! -x "$B" ]; then
   echo "$(date -u +%FT%TZ) building $B (about 6 minutes on an idle machine)"
   mkdir -p "$(dirname "$B")" /work/pgo
   xz -dc "$repo/notebook/performance/pgo-2026-12-06/grit.profdata.xz" > /work/pgo/grit.profdata
-  [ -d /work/cand ] || git -C "$repo" worktree add /work/cand "$commit"
-  (cd /work/cand && RUSTFLAGS="-C target-cpu=native -Cprofile-use=/work/pgo/grit.profdata" \
-    CARGO_TARGET_DIR=/work/target-pgo-use cargo build --release --bin grit)
-  cp /work/target-pgo-use/release/grit "$B"
+  if [ ! -d /work/cert ]; then
+    git -C "$repo" worktree add --detach /work/cert "$commit"
+    (cd /work/cert && GIT_COMMITTER_NAME="Seed 137f0062 maintainers" \
+      GIT_COMMITTER_EMAIL=maintainers@users.noreply.h-seed-137f0062.example \
+      git am --committer-date-is-author-date -q "$patch")
+  fi
+  [ "$(git -C /work/cert rev-parse HEAD)" = "$patched" ] || { echo "restart.sh: /work/cert is not $patched" >&2; exit 1; }
+  (cd /work/cert && RUSTFLAGS="-C target-cpu=native -Cprofile-use=/work/pgo/grit.profdata" \
+    CARGO_TARGET_DIR=/work/target-pgo-cert cargo build --release --bin grit)
+  cp /work/target-pgo-cert/release/grit "$B"
 fi
 # The campaigns' bits: the engine fingerprints and the two 3-impact samples' md5s.
 v=$("$B" version)
