@@ -21,7 +21,7 @@ B=${B:-/work/bins/grit-5604815-cert-native-pgo}
 R=${R:-/work/runs}
 commit=5604815
 # The patch applied with its own author as committer and date gives this commit on any machine.
-patched=25136284cf4e04050332c34ca1d2f5dc0efb4498
+patched=4a40e0963c52c113d58766493e5403826ee39dce
 patch=$repo/notebook/performance/certified-return-2026-12-07/certified-return.patch
 if [ ! -x "$B" ]; then
   echo "$(date -u +%FT%TZ) building $B (about 6 minutes on an idle machine)"
