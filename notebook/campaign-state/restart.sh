@@ -1,7 +1,8 @@
 #!/bin/bash
 # Brings the long campaigns back on a new machine, as the sessions' notes did by hand: builds the
 # pinned binary (5604815 with the certified radial return of
-# notebook/performance/certified-return-2026-12-07/, built for the CPU and guided by the profile
+# notebook/performance/certified-return-2026-12-07/ and the half pairs four at a time of
+# notebook/performance/chunked-pairs-2026-12-07/, built for the CPU and guided by the profile
 # kept in notebook/performance/pgo-2026-12-06/) unless it is there, refuses it unless it computes
 # the campaigns' bits, restores each named campaign from this folder's saves unless its run folder
 # exists, then starts one lane per argument (then.sh), the checkpoint keeper and save-every.sh.
@@ -17,24 +18,25 @@ if [ "${1:-}" = "--no-start" ]; then start=0; shift; fi
 session=$1; shift
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
-B=${B:-/work/bins/grit-5604815-cert-native-pgo}
+B=${B:-/work/bins/grit-5604815-chunk-native-pgo}
 R=${R:-/work/runs}
 commit=5604815
-# The patch applied with its own author as committer and date gives this commit on any machine.
-patched=4a40e0963c52c113d58766493e5403826ee39dce
-patch=$repo/notebook/performance/certified-return-2026-12-07/certified-return.patch
+# The patches applied with their own author as committer and date give this commit on any machine.
+patched=a9dccb05472a57fab2af92445bc9f39e29a0e3e4
+patch=$repo/notebook/performance/chunked-pairs-2026-12-07/campaign.patch
+src=/work/campaign-src
 if [ ! -x "$B" ]; then
   echo "$(date -u +%FT%TZ) building $B (about 6 minutes on an idle machine)"
   mkdir -p "$(dirname "$B")" /work/pgo
   xz -dc "$repo/notebook/performance/pgo-2026-12-06/grit.profdata.xz" > /work/pgo/grit.profdata
-  if [ ! -d /work/cert ]; then
-    git -C "$repo" worktree add --detach /work/cert "$commit"
-    (cd /work/cert && GIT_COMMITTER_NAME="Seed 137f0062 maintainers" \
+  if [ ! -d $src ]; then
+    git -C "$repo" worktree add --detach $src "$commit"
+    (cd $src && GIT_COMMITTER_NAME="Seed 137f0062 maintainers" \
       GIT_COMMITTER_EMAIL=maintainers@users.noreply.h-seed-137f0062.example \
       git am --committer-date-is-author-date -q "$patch")
   fi
-  [ "$(git -C /work/cert rev-parse HEAD)" = "$patched" ] || { echo "restart.sh: /work/cert is not $patched" >&2; exit 1; }
-  (cd /work/cert && RUSTFLAGS="-C target-cpu=native -Cprofile-use=/work/pgo/grit.profdata" \
+  [ "$(git -C $src rev-parse HEAD)" = "$patched" ] || { echo "restart.sh: $src is not $patched" >&2; exit 1; }
+  (cd $src && RUSTFLAGS="-C target-cpu=native -Cprofile-use=/work/pgo/grit.profdata" \
     CARGO_TARGET_DIR=/work/target-pgo-cert cargo build --release --bin grit)
   cp /work/target-pgo-cert/release/grit "$B"
 fi
