@@ -3,7 +3,8 @@
 usage: remaining.py DB END [SINCE_UTC | MS_PER_STEP]
   DB         a campaign's grit.db (opened read-only)
   END        impacts per sample a cell is assumed to run to before it balances (the balanced
-             cells so far: 280 at 15°, 380-420 at 45°, 480-520 at 90°)
+             cells so far: 280 at 15°, 380-420 at 45°, 480-520 at 90°); one number for every
+             cell, or a default with angles of their own after it: 420,90=520
   SINCE_UTC  measure the CPU per step over the impacts stored since then (default: the last
              hour), e.g. 2026-12-07T00:11
   MS_PER_STEP  or the CPU per step given, for a campaign not running now (scale another
@@ -25,7 +26,9 @@ import time
 from collections import defaultdict
 from datetime import datetime, timezone
 
-db, end = sys.argv[1], int(sys.argv[2])
+db = sys.argv[1]
+default_end, *own = sys.argv[2].split(",")
+ends = {float(a): int(e) for a, e in (o.split("=") for o in own)}
 given = None
 since = time.time() - 3600
 if len(sys.argv) > 3:
@@ -69,16 +72,18 @@ def line(cell):
 
 
 cells = con.execute(
-    "select cell_index, count(*), group_concat(units_done), min(state = 'done') "
-    "from jobs group by cell_index order by cell_index"
+    "select j.cell_index, count(*), group_concat(j.units_done), min(j.state = 'done'), c.angle_deg "
+    "from jobs j join cells c on c.campaign_id = j.campaign_id and c.cell_index = j.cell_index "
+    "group by j.cell_index order by j.cell_index"
 ).fetchall()
 lines = {c: line(c) for c in steps if len(steps[c]) >= 40}
 total = 0.0
 print(f"CPU per step: {s_step * 1000:.2f} ms " + ("(given)" if given else f"(median of {len(per_step)} impacts)"))
-print("cell  samples  done per sample  steps, CPU-s per impact now  impacts to go  CPU-h")
-for cell, n, done, finished in cells:
+print("cell  angle  samples  done per sample  steps, CPU-s per impact now  to  impacts to go  CPU-h")
+for cell, n, done, finished, angle in cells:
     if finished:
         continue  # every job done: the cell is final (a cell to grow is extended at once)
+    end = ends.get(float(angle), int(default_end))
     done = [int(d) for d in done.split(",")]
     go = sum(max(end - d, 0) for d in done)
     if cell in lines:
@@ -91,5 +96,5 @@ for cell, n, done, finished in cells:
     cost = sum(f(u) for d in done for u in range(d + 1, end + 1))
     hours = cost * s_step / 3600
     total += hours
-    print(f"{cell:4}  {n:7}  {min(done)}-{max(done):<14}  {now:6.0f}, {now * s_step:5.1f}{'':16}  {go:13}  {hours:5.1f}")
-print(f"total {total:.1f} CPU-hours to {end} impacts per sample")
+    print(f"{cell:4}  {angle:5g}  {n:7}  {min(done)}-{max(done):<14}  {now:6.0f}, {now * s_step:5.1f}{'':16}  {end:3}  {go:12}  {hours:5.1f}")
+print(f"total {total:.1f} CPU-hours to {sys.argv[2]} impacts per sample")
