@@ -65,28 +65,49 @@ impl Kernel {
         self.w_dw(r).0
     }
 
+    /// The quintic's W and dW/dr at q = r/h (seed eq. 4).
+    #[inline(always)]
+    fn quintic(&self, q: f64) -> (f64, f64) {
+        // Clamped powers instead of branches on q: pairs come in random order of q, and
+        // mispredicted branches cost more than the spare arithmetic. A term that is
+        // clamped to zero adds exactly +0, so the values equal the branchy form's.
+        let a = (3.0 - q).max(0.0);
+        let b = (2.0 - q).max(0.0);
+        let c = (1.0 - q).max(0.0);
+        let (a4, b4, c4) = (a * a * a * a, b * b * b * b, c * c * c * c);
+        let mut w = a4 * a;
+        let mut dw = -5.0 * a4;
+        w -= 6.0 * b4 * b;
+        dw += 30.0 * b4;
+        w += 15.0 * c4 * c;
+        dw -= 75.0 * c4;
+        (self.norm * w, self.norm * self.inv_h * dw)
+    }
+
+    /// `w_dw` of several distances, lane by lane by the same operations, so that the square
+    /// roots and quotients around it can be packed.
+    #[inline(always)]
+    pub fn w_dw_lanes<const L: usize>(&self, r: [f64; L]) -> ([f64; L], [f64; L]) {
+        let (mut w, mut dw) = ([0.0; L], [0.0; L]);
+        if self.kind == KernelKind::Quintic {
+            for n in 0..L {
+                (w[n], dw[n]) = self.quintic(r[n] * self.inv_h);
+            }
+        } else {
+            for n in 0..L {
+                (w[n], dw[n]) = self.w_dw(r[n]);
+            }
+        }
+        (w, dw)
+    }
+
     /// W(r) and dW/dr together (dW/dr in 1/m³); shares the powers of (3 − q). Always inlined:
     /// the pair loops call it once per pair, where a call costs more than its arithmetic.
     #[inline(always)]
     pub fn w_dw(&self, r: f64) -> (f64, f64) {
         let q = r * self.inv_h;
         match self.kind {
-            KernelKind::Quintic => {
-                // Clamped powers instead of branches on q: pairs come in random order of q, and
-                // mispredicted branches cost more than the spare arithmetic. A term that is
-                // clamped to zero adds exactly +0, so the values equal the branchy form's.
-                let a = (3.0 - q).max(0.0);
-                let b = (2.0 - q).max(0.0);
-                let c = (1.0 - q).max(0.0);
-                let (a4, b4, c4) = (a * a * a * a, b * b * b * b, c * c * c * c);
-                let mut w = a4 * a;
-                let mut dw = -5.0 * a4;
-                w -= 6.0 * b4 * b;
-                dw += 30.0 * b4;
-                w += 15.0 * c4 * c;
-                dw -= 75.0 * c4;
-                (self.norm * w, self.norm * self.inv_h * dw)
-            }
+            KernelKind::Quintic => self.quintic(q),
             KernelKind::WendlandC2 => {
                 if q >= 2.0 {
                     return (0.0, 0.0);
