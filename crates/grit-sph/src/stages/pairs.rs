@@ -419,18 +419,22 @@ pub(crate) fn pairs_of<'a>(
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from a xorshift generator: the same rows on every machine.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The lanes must give each pair the single pair's bits: in the support, on its edge,
     /// beyond it and coincident, for every kernel.
     #[test]
     fn pairs_evaluated_four_at_a_time_have_the_single_pairs_bits() {
         use crate::kernel::KernelKind;
-        let mut seed = 0x9e3779b97f4a7c15u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x9e3779b97f4a7c15);
         let mut checked = [0usize; 3];
         for kind in [
             KernelKind::Quintic,
@@ -477,13 +481,7 @@ mod tests {
     /// have the pair-by-pair loop's bits: whichever path a worker's CPU takes, the same pairs.
     #[test]
     fn every_row_fill_has_the_pair_by_pair_bits() {
-        let mut seed = 0x2545f4914f6cdd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x2545f4914f6cdd1d);
         let k = Kernel::new(crate::kernel::KernelKind::Quintic, 9.4e-6);
         let r2max = k.radius() * k.radius();
         let mut compared = 0;
