@@ -356,6 +356,11 @@ fn impact_bench_prints_its_fields_with_medians_of_repeats() {
     }
     // The same impact again, so the same steps: the ceiling times the pairs the run used.
     assert_eq!(c["steps"], v["steps"], "{v}");
+    // Which path the pair pass took, so that two machines' figures are compared knowingly.
+    assert!(
+        ["four at a time (AVX2)", "pair by pair"].contains(&v["pair_pass"].as_str().unwrap()),
+        "{v}"
+    );
     // The old model: every grain particle, and the flight simulated step by step.
     let full = run(&["--full-grain", "--full-flight"]);
     assert!(full["particles"].as_u64() > v["particles"].as_u64());

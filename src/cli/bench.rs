@@ -331,6 +331,7 @@ fn impact(
             runs(&b.wall_1_thread_s_runs)
         );
     }
+    say!("pair pass                 {}", b.pair_pass);
     say!("wall ({} threads)          {:.2} s", b.threads, b.wall_s);
     say!("wall (1 thread)           {:.2} s", b.wall_1_thread_s);
     say!("particle-steps/s          {:.3e}", b.particle_steps_per_s);

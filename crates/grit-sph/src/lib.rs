@@ -47,3 +47,13 @@ pub use world::{
     Outflow, PenaltyParams, Settings, WallLoad, World, WorldState,
 };
 pub mod verification;
+
+/// Which path the pair pass (seed eqs. 4, 8–9: the kernel of each same-body pair) takes on
+/// this CPU: "four at a time (AVX2)" or "pair by pair"; both give the same bits.
+pub fn pair_pass() -> &'static str {
+    if stages::pairs::lanes_pay() {
+        "four at a time (AVX2)"
+    } else {
+        "pair by pair"
+    }
+}

@@ -51,6 +51,10 @@ pub struct ImpactBench {
     /// The bare kernel-sum loop over the same pairs, timed in the same run.
     #[serde(default)]
     pub ceiling: Option<Ceiling>,
+    /// The pair pass's path on this CPU (`grit_sph::pair_pass`): figures of two machines
+    /// compare only where it is the same.
+    #[serde(default)]
+    pub pair_pass: String,
 }
 
 /// The ceiling of the pair loops: after every step of one more run of the same impact on 1
@@ -165,6 +169,7 @@ pub fn impact(sample: &Sample, threads: usize, repeats: usize) -> Result<ImpactB
         stages_1_thread: last_one.unwrap_or_default(),
         surface_impacts: sample.impacts_done(),
         ceiling,
+        pair_pass: grit_sph::pair_pass().to_string(),
     })
 }
 

@@ -12,7 +12,7 @@ mod forces;
 mod integrate;
 mod interface;
 mod kernel_sums;
-mod pairs;
+pub(crate) mod pairs;
 mod rigid;
 mod stress;
 mod time_step;

@@ -211,7 +211,7 @@ pub(crate) fn fill_half_pairs(
 /// Whether this CPU has 256-bit vectors (AVX2), on which a row's pairs evaluated four at a time
 /// pay (0.95x the CPU of a worn impact); on SSE2 alone they cost more than the branch on the
 /// support they save (1.025x the reference impact), so such a CPU keeps the pair-by-pair loop.
-fn lanes_pay() -> bool {
+pub(crate) fn lanes_pay() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2")
