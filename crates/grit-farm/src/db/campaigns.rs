@@ -19,6 +19,14 @@ use crate::error::{Error, Result};
 /// Window over which the impact rate (and so the ETA) is measured.
 const RATE_WINDOW_MS: i64 = 120_000;
 
+/// The units one campaign stored since a time, and the first of them: the rate's window.
+/// CROSS JOIN keeps units the outer loop, so the count walks `units_recent` over the window's
+/// few rows; left to itself SQLite walked every unit of the campaign's jobs (1.7 s at 29 000
+/// units, on a machine loaded by the campaign's own workers).
+pub(super) const RECENT_UNITS: &str = "SELECT COUNT(*) AS n, MIN(u.created_ms) AS first
+     FROM units u CROSS JOIN jobs j ON j.id = u.job_id
+     WHERE j.campaign_id = ? AND u.created_ms > ?";
+
 /// A scene's results JSON object with the campaign's pinned `engine` and its creator's
 /// `commit` in front. The keys are spliced in rather than the body parsed and written again,
 /// which would cost a pass over a raw listing of every record and could reorder its keys. An
@@ -262,15 +270,11 @@ impl Store {
         let impacts_total = c.get::<i64, _>("units_total") as u64;
         let now = now_ms();
         let scene = scene_of(&c);
-        let recent = sqlx::query(
-            "SELECT COUNT(*) AS n, MIN(u.created_ms) AS first FROM units u
-             JOIN jobs j ON j.id = u.job_id
-             WHERE j.campaign_id = ? AND u.created_ms > ?",
-        )
-        .bind(&ids)
-        .bind(now - RATE_WINDOW_MS)
-        .fetch_one(&self.read)
-        .await?;
+        let recent = sqlx::query(RECENT_UNITS)
+            .bind(&ids)
+            .bind(now - RATE_WINDOW_MS)
+            .fetch_one(&self.read)
+            .await?;
         let n: i64 = recent.get("n");
         // Over a window that starts at the first recent impact, so a fresh campaign's rate is
         // not diluted by the minutes before it started.
@@ -403,7 +407,7 @@ impl Store {
         .fetch_all(&self.read)
         .await?;
         let rows = sqlx::query(
-            "SELECT u.job_id, u.record FROM units u JOIN jobs j ON j.id = u.job_id
+            "SELECT u.job_id, u.record FROM units u CROSS JOIN jobs j ON j.id = u.job_id
              WHERE j.campaign_id = ? ORDER BY u.job_id, u.unit",
         )
         .bind(id.to_string())

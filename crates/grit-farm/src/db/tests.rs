@@ -407,3 +407,46 @@ async fn a_job_behind_its_stored_impacts_shows_its_replay_until_it_catches_up() 
         .unwrap();
     assert_eq!(replaying(s.status(id).await.unwrap()), None, "done");
 }
+
+#[tokio::test]
+async fn the_rate_counts_the_campaigns_own_recent_impacts_through_their_index() {
+    use crate::loadtest::placeholder_record;
+    use sqlx::Row;
+
+    let dir = tempfile::tempdir().unwrap();
+    let s = store(dir.path(), 60_000).await;
+    let spec = one_sample(20);
+    let first = s.create_campaign(&spec, None).await.unwrap().id;
+    let other = s.create_campaign(&spec, None).await.unwrap().id;
+    let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
+    let records: Vec<_> = (1..=3)
+        .map(|k| placeholder_record(k, grain, 1e-7 * f64::from(k)))
+        .collect();
+    let j = s.claim("w").await.unwrap().unwrap();
+    let (ran, idle) = (
+        j.campaign_id,
+        if j.campaign_id == first { other } else { first },
+    );
+    s.heartbeat(j.job_id, j.lease_id, imp(&records))
+        .await
+        .unwrap();
+    let rate = s.status(ran).await.unwrap().rate_impacts_per_s;
+    assert!(rate.is_some_and(|r| r > 0.0), "{rate:?}");
+    assert_eq!(s.status(idle).await.unwrap().rate_impacts_per_s, None);
+    let plan: Vec<String> = sqlx::query(&format!(
+        "EXPLAIN QUERY PLAN {}",
+        super::campaigns::RECENT_UNITS
+    ))
+    .bind(ran.to_string())
+    .bind(0_i64)
+    .fetch_all(&s.read)
+    .await
+    .unwrap()
+    .iter()
+    .map(|r| r.get::<String, _>("detail"))
+    .collect();
+    assert!(
+        plan.first().is_some_and(|p| p.contains("units_recent")),
+        "the window's units are found by created_ms first: {plan:?}"
+    );
+}
