@@ -8,7 +8,7 @@
 # exists, then starts one lane per argument (then.sh), the checkpoint keeper and save-every.sh.
 #   bash notebook/campaign-state/restart.sh [--no-start] SESSION LANE...   (from the repository's root)
 # LANE: campaign names run one after another in one lane, joined by commas (ppd48, or
-# ppd24b,paper). SESSION names save-every.sh's files (e.g. s53). --no-start stops after the
+# paper,paper-shapes). SESSION names save-every.sh's files (e.g. s53). --no-start stops after the
 # restore (R may name a scratch folder for a trial; keep-fast.sh watches /work/runs alone, so the
 # lanes are started only with the default R).
 set -euo pipefail
@@ -53,6 +53,8 @@ for lane in "$@"; do
   for name in ${lane//,/ }; do
     if [ -e "$R/$name/grit.db" ]; then
       echo "$name: $R/$name/grit.db exists, not restored"
+    elif [ ! -e "$here/$name.sql" ]; then
+      echo "$name: no save in $here, starts from its spec when its lane gets to it"
     else
       bash "$here/restore.sh" "$here/$name.sql" "$R/$name"
     fi
