@@ -9,6 +9,7 @@ use uuid::Uuid;
 use super::{imp, impact_params, impact_results, Store};
 use crate::api::{CampaignState, JobState};
 use crate::error::Error;
+use crate::loadtest::placeholder_record;
 
 const TINY: &str = r#"{"angles_deg": [90], "shapes": ["hexagon"], "samples": 2, "impacts": 2,
     "allow_short_samples": true, "spacing_m": 25e-6}"#;
@@ -21,6 +22,14 @@ fn one_sample(impacts: u32) -> CampaignSpec {
             .replace(r#""impacts": 2"#, &format!(r#""impacts": {impacts}"#)),
     )
     .unwrap()
+}
+
+/// Impacts 1..=n of `spec`'s first cell, each losing 1e-7 k kg/m.
+fn records(spec: &CampaignSpec, n: u32) -> Vec<grit_erosion::ImpactRecord> {
+    let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
+    (1..=n)
+        .map(|k| placeholder_record(k, grain, 1e-7 * f64::from(k)))
+        .collect()
 }
 
 async fn store(dir: &Path, ttl_ms: u64) -> Store {
@@ -210,7 +219,6 @@ async fn a_full_database_is_503_and_recovers() {
 async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_dropped() {
     use crate::api::Checkpoint;
     use crate::checkpoint::CheckpointBytes;
-    use crate::loadtest::placeholder_record;
 
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path(), 60_000).await;
@@ -271,8 +279,6 @@ async fn long_reports_and_checkpoints_round_trip_and_a_done_jobs_checkpoint_is_d
 
 #[tokio::test]
 async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
-    use crate::loadtest::placeholder_record;
-
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path(), 60_000).await;
     let spec = CampaignSpec::from_json(TINY).unwrap();
@@ -343,16 +349,12 @@ async fn impacts_must_carry_the_cells_grain_and_lose_less_than_the_surface() {
 async fn a_job_behind_its_stored_impacts_shows_its_replay_until_it_catches_up() {
     use crate::api::Replaying;
     use crate::checkpoint::CheckpointBytes;
-    use crate::loadtest::placeholder_record;
 
     let dir = tempfile::tempdir().unwrap();
     let s = store(dir.path(), 60_000).await;
     let spec = one_sample(20);
     let id = s.create_campaign(&spec, None).await.unwrap().id;
-    let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
-    let records: Vec<_> = (1..=20)
-        .map(|k| placeholder_record(k, grain, 1e-7 * f64::from(k)))
-        .collect();
+    let records = records(&spec, 20);
     let replaying = |st: crate::api::CampaignStatus| st.replaying;
 
     let j = s.claim("w").await.unwrap().unwrap();
@@ -410,7 +412,6 @@ async fn a_job_behind_its_stored_impacts_shows_its_replay_until_it_catches_up() 
 
 #[tokio::test]
 async fn the_rate_counts_the_campaigns_own_recent_impacts_through_their_index() {
-    use crate::loadtest::placeholder_record;
     use sqlx::Row;
 
     let dir = tempfile::tempdir().unwrap();
@@ -418,10 +419,7 @@ async fn the_rate_counts_the_campaigns_own_recent_impacts_through_their_index() 
     let spec = one_sample(20);
     let first = s.create_campaign(&spec, None).await.unwrap().id;
     let other = s.create_campaign(&spec, None).await.unwrap().id;
-    let grain = spec.cells().unwrap()[0].params.grain_mass_kg_m();
-    let records: Vec<_> = (1..=3)
-        .map(|k| placeholder_record(k, grain, 1e-7 * f64::from(k)))
-        .collect();
+    let records = records(&spec, 3);
     let j = s.claim("w").await.unwrap().unwrap();
     let (ran, idle) = (
         j.campaign_id,
