@@ -10,7 +10,8 @@
 # LANE: campaign names run one after another in one lane, joined by commas (ppd48, or
 # paper,paper-shapes). SESSION names save-every.sh's files (e.g. s53). --no-start stops after the
 # restore (R may name a scratch folder for a trial; keep-fast.sh watches /work/runs alone, so the
-# lanes are started only with the default R).
+# lanes are started only with the default R). W=2 gives each lane's campaigns two workers: for
+# paper-shapes once it is the only campaign left (`W=2 restart.sh SESSION paper-shapes`).
 set -euo pipefail
 start=1
 if [ "${1:-}" = "--no-start" ]; then start=0; shift; fi
@@ -64,7 +65,7 @@ done
 [ "$R" = /work/runs ] || { echo "restart.sh: lanes start only in /work/runs (keep-fast.sh)" >&2; exit 2; }
 cd "$repo"
 for lane in "$@"; do
-  B=$B R=$R setsid nohup bash "$here/then.sh" 0 ${lane//,/ } > /dev/null 2>&1 < /dev/null &
+  B=$B R=$R W=${W:-1} setsid nohup bash "$here/then.sh" 0 ${lane//,/ } > /dev/null 2>&1 < /dev/null &
 done
 setsid nohup bash "$repo/notebook/erosion/walls-2026-11-29/keep-fast.sh" > /dev/null 2>&1 < /dev/null &
 RUNS=$R setsid nohup bash "$here/save-every.sh" 2700 "$session" >> "$R/save-every.log" 2>&1 < /dev/null &

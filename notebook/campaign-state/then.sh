@@ -1,12 +1,14 @@
 #!/bin/bash
 # Waits for process PID to end (0: not at all), then runs the named campaigns one after another
-# as lanes-after.sh's lanes do: one worker and one thread each, nice 12, logs in $R/NAME.log,
+# as lanes-after.sh's lanes do: W workers (default one) of one thread each, nice 12, logs in $R/NAME.log,
 # starts and ends in $R/lanes.log. For a lane whose order has to change while lanes-after.sh
 # runs (a running bash script must not be edited).
 #   bash notebook/campaign-state/then.sh PID NAME...      (from the repository's root)
 # NAME: ppd48, ppd16c, ppd24b, paper or paper-shapes.
 B=${B:-/work/bins/grit-5604815-native}
 R=${R:-/work/runs}
+# W: workers (one thread each); 2 for the last campaign once it runs alone on both cores.
+W=${W:-1}
 pid=$1; shift
 spec_of() {
   case "$1" in
@@ -27,7 +29,7 @@ if [ "$pid" != 0 ]; then
   echo "$(date -u +%FT%TZ) then.sh saw process $pid go" >> "$R/lanes.log"
 fi
 for name in "$@"; do
-  echo "$(date -u +%FT%TZ) start $name --workers 1 (then.sh)" >> "$R/lanes.log"
-  nice -n 12 "$B" run "$(spec_of "$name")" --out "$R/$name" --threads 1 --workers 1 >> "$R/$name.log" 2>&1
+  echo "$(date -u +%FT%TZ) start $name --workers $W (then.sh)" >> "$R/lanes.log"
+  nice -n 12 "$B" run "$(spec_of "$name")" --out "$R/$name" --threads 1 --workers "$W" >> "$R/$name.log" 2>&1
   echo "$(date -u +%FT%TZ) end $name (exit $?, then.sh)" >> "$R/lanes.log"
 done
