@@ -146,7 +146,8 @@ pub struct CampaignStatus {
     pub impacts_total: u64,
     /// Jobs per state.
     pub jobs: JobCounts,
-    /// Impacts per second over the last few minutes; `null` before any impact.
+    /// Impacts per second over the last 2 minutes, or over the last 20 impacts when fewer came
+    /// in 2 minutes (at most 30 minutes back); `null` with fewer than two impacts in that time.
     pub rate_impacts_per_s: Option<f64>,
     /// Seconds to finish at that rate; `null` when unknown.
     pub eta_s: Option<f64>,

@@ -16,8 +16,14 @@ use crate::api::{
 };
 use crate::error::{Error, Result};
 
-/// Window over which the impact rate (and so the ETA) is measured.
+/// Window over which the impact rate (and so the ETA) is measured while it holds at least
+/// `RATE_MIN_UNITS` units.
 const RATE_WINDOW_MS: i64 = 120_000;
+/// A slower campaign's rate is taken over its last `RATE_MIN_UNITS` units instead, no further
+/// back than `RATE_LONGEST_MS`: at one impact per 30 s two minutes hold four, and the ETA of a
+/// long campaign jumped by half from one progress line to the next.
+const RATE_MIN_UNITS: i64 = 20;
+const RATE_LONGEST_MS: i64 = 1_800_000;
 
 /// The units one campaign stored since a time, and the first of them: the rate's window.
 /// CROSS JOIN keeps units the outer loop, so the count walks `units_recent` over the window's
@@ -26,6 +32,13 @@ const RATE_WINDOW_MS: i64 = 120_000;
 pub(super) const RECENT_UNITS: &str = "SELECT COUNT(*) AS n, MIN(u.created_ms) AS first
      FROM units u CROSS JOIN jobs j ON j.id = u.job_id
      WHERE j.campaign_id = ? AND u.created_ms > ?";
+
+/// The times of one campaign's latest units since a time, newest first, at most a number of
+/// them; through `units_recent` as `RECENT_UNITS`.
+pub(super) const LATEST_UNITS: &str = "SELECT u.created_ms AS t
+     FROM units u CROSS JOIN jobs j ON j.id = u.job_id
+     WHERE j.campaign_id = ? AND u.created_ms > ?
+     ORDER BY u.created_ms DESC LIMIT ?";
 
 /// A scene's results JSON object with the campaign's pinned `engine` and its creator's
 /// `commit` in front. The keys are spliced in rather than the body parsed and written again,
@@ -275,11 +288,20 @@ impl Store {
             .bind(now - RATE_WINDOW_MS)
             .fetch_one(&self.read)
             .await?;
-        let n: i64 = recent.get("n");
-        // Over a window that starts at the first recent impact, so a fresh campaign's rate is
-        // not diluted by the minutes before it started.
-        let rate = recent
-            .get::<Option<i64>, _>("first")
+        let (mut n, mut first): (i64, Option<i64>) = (recent.get("n"), recent.get("first"));
+        if n < RATE_MIN_UNITS {
+            let latest = sqlx::query(LATEST_UNITS)
+                .bind(&ids)
+                .bind(now - RATE_LONGEST_MS)
+                .bind(RATE_MIN_UNITS)
+                .fetch_all(&self.read)
+                .await?;
+            n = latest.len() as i64;
+            first = latest.last().map(|r| r.get("t"));
+        }
+        // Over a window that starts at the first of the units counted, so a fresh campaign's
+        // rate is not diluted by the minutes before it started.
+        let rate = first
             .filter(|_| n > 1)
             .map(|first| n as f64 / ((now - first).max(1000) as f64 / 1000.0));
         // A running job is behind until its worker has reported its stored units again from

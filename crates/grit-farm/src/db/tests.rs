@@ -411,7 +411,8 @@ async fn a_job_behind_its_stored_impacts_shows_its_replay_until_it_catches_up() 
 }
 
 #[tokio::test]
-async fn the_rate_counts_the_campaigns_own_recent_impacts_through_their_index() {
+async fn the_rate_counts_the_campaigns_own_impacts_through_their_index_back_to_the_last_20() {
+    use super::campaigns::{LATEST_UNITS, RECENT_UNITS};
     use sqlx::Row;
 
     let dir = tempfile::tempdir().unwrap();
@@ -431,20 +432,32 @@ async fn the_rate_counts_the_campaigns_own_recent_impacts_through_their_index() 
     let rate = s.status(ran).await.unwrap().rate_impacts_per_s;
     assert!(rate.is_some_and(|r| r > 0.0), "{rate:?}");
     assert_eq!(s.status(idle).await.unwrap().rate_impacts_per_s, None);
-    let plan: Vec<String> = sqlx::query(&format!(
-        "EXPLAIN QUERY PLAN {}",
-        super::campaigns::RECENT_UNITS
-    ))
-    .bind(ran.to_string())
-    .bind(0_i64)
-    .fetch_all(&s.read)
-    .await
-    .unwrap()
-    .iter()
-    .map(|r| r.get::<String, _>("detail"))
-    .collect();
+    for (sql, limit) in [(RECENT_UNITS, None), (LATEST_UNITS, Some(20_i64))] {
+        let q = format!("EXPLAIN QUERY PLAN {sql}");
+        let mut q = sqlx::query(&q).bind(ran.to_string()).bind(0_i64);
+        if let Some(limit) = limit {
+            q = q.bind(limit);
+        }
+        let plan: Vec<String> = q
+            .fetch_all(&s.read)
+            .await
+            .unwrap()
+            .iter()
+            .map(|r| r.get::<String, _>("detail"))
+            .collect();
+        assert!(
+            plan.first().is_some_and(|p| p.contains("units_recent")),
+            "the window's units are found by created_ms first: {plan:?}"
+        );
+    }
+    // A slow campaign: no impact in the last 2 minutes, three 5 minutes ago.
+    sqlx::query("UPDATE units SET created_ms = created_ms - 300000")
+        .execute(&s.write)
+        .await
+        .unwrap();
+    let rate = s.status(ran).await.unwrap().rate_impacts_per_s;
     assert!(
-        plan.first().is_some_and(|p| p.contains("units_recent")),
-        "the window's units are found by created_ms first: {plan:?}"
+        rate.is_some_and(|r| (0.008..0.012).contains(&r)),
+        "3 impacts over 300 s: {rate:?}"
     );
 }
