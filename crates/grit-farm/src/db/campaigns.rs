@@ -429,7 +429,7 @@ impl Store {
         .fetch_all(&self.read)
         .await?;
         let rows = sqlx::query(
-            "SELECT u.job_id, u.record FROM units u CROSS JOIN jobs j ON j.id = u.job_id
+            "SELECT u.job_id, u.record FROM units u JOIN jobs j ON j.id = u.job_id
              WHERE j.campaign_id = ? ORDER BY u.job_id, u.unit",
         )
         .bind(id.to_string())
