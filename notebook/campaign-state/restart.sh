@@ -7,7 +7,7 @@
 # the campaigns' bits, restores each named campaign from this folder's saves unless its run folder
 # exists, then starts one lane per argument (then.sh), the checkpoint keeper and save-every.sh.
 #   bash notebook/campaign-state/restart.sh [--no-start] SESSION LANE...   (from the repository's root)
-# LANE: campaign names run one after another in one lane, joined by commas (ppd48, or
+# LANE: campaign names run one after another in one lane, joined by commas (ppd48,ppd64, or
 # paper,paper-shapes). SESSION names save-every.sh's files (e.g. s53). --no-start stops after the
 # restore (R may name a scratch folder for a trial; keep-fast.sh watches /work/runs alone, so the
 # lanes are started only with the default R). W=2 gives each lane's campaigns two workers: for
