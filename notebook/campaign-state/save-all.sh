@@ -12,7 +12,7 @@ runs=${1:-/work/runs}
 scratch=$(mktemp -d)
 failed=0
 trap 'rm -rf "$scratch"' EXIT
-for spec in paper:paper paper-shapes:paper-shapes ppd48:ppd48 ppd64:ppd64 ppd24b:ppd24b ppd16c:ppd16c box32-big:box32/big box32-std:box32/std \
+for spec in paper:paper paper-shapes:paper-shapes ppd48:ppd48 ppd64:ppd64 box48-big:box48-big ppd24b:ppd24b ppd16c:ppd16c box32-big:box32/big box32-std:box32/std \
     newton-new:newton-new; do
   name=${spec%%:*}
   db=$runs/${spec#*:}/grit.db

@@ -3,7 +3,7 @@
 # proper looks every 10 minutes, too rarely to catch them): the stock inside the box at each
 # 20-impact window is what judges stationarity away from the box's fixed sides.
 while true; do
-  for c in ppd16c ppd24b paper ppd48 ppd64 paper-shapes; do
+  for c in ppd16c ppd24b paper ppd48 ppd64 box48-big paper-shapes; do
     mkdir -p /work/runs/ckpt-keep/$c
     sqlite3 /work/runs/$c/grit.db "select j.cell_index||'-'||j.sample_index, k.units_done, k.job_id from checkpoints k join jobs j on j.id = k.job_id where k.units_done % 20 = 0" 2>/dev/null |
     while IFS='|' read name n id; do
