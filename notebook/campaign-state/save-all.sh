@@ -1,5 +1,5 @@
 #!/bin/bash
-# Saves every long run's database with its checkpoints into this folder (save.sh), then
+# Saves every long run's database (campaigns.tsv) with its checkpoints into this folder (save.sh), then
 # restores each save into a scratch folder (restore.sh) and checks it: integrity, at least the
 # units the live database held just before the save (the runs go on writing), and every
 # checkpoint's SHA-256 against its data.
@@ -12,10 +12,8 @@ runs=${1:-/work/runs}
 scratch=$(mktemp -d)
 failed=0
 trap 'rm -rf "$scratch"' EXIT
-for spec in paper:paper paper-shapes:paper-shapes ppd48:ppd48 ppd64:ppd64 box48-big:box48-big ppd24b:ppd24b ppd16c:ppd16c box32-big:box32/big box32-std:box32/std \
-    newton-new:newton-new; do
-  name=${spec%%:*}
-  db=$runs/${spec#*:}/grit.db
+while read -r name _ folder <&3; do
+  db=$runs/$folder/grit.db
   [ -e "$db" ] || { echo "$name: no $db, skipped"; continue; }
   live=$(sqlite3 "file:$db?mode=ro" "select count(*) from units")
   bash "$here/save.sh" "$db" "$here/$name.sql" --checkpoints
@@ -34,5 +32,5 @@ print(f"{name}: {verdict}; {units} units (live before the save: {live}), {len(ck
 sys.exit(0 if verdict == "ok" else 1)
 PY
   then :; else failed=1; fi
-done
+done 3< <(grep -v '^#' "$here/campaigns.tsv")
 exit $failed
