@@ -7,8 +7,10 @@ mod common;
 use common::png_ok;
 use std::process::{Command, Output};
 
+use grit_erosion::studies::settle::SettleRow;
 use grit_erosion::studies::stability::{Failure, Panel, StabilityPoint, Verdict};
 use grit_erosion::studies::sweep::SweepRow;
+use grit_erosion::{ImpactParams, Sample};
 
 fn grit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_grit"))
@@ -178,6 +180,50 @@ fn the_budget_study_charges_each_impact_and_groups_by_angle() {
     );
 }
 
+/// From a worn surface, the settle study's reference path is the sample's own (the same impacts,
+/// bit for bit), and a looser end stops each impact no later, from the same state.
+#[test]
+fn the_settle_study_resumes_a_checkpoint_and_a_looser_end_stops_sooner() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = ImpactParams {
+        angle_deg: 45.0,
+        spacing_m: COARSE.parse().unwrap(),
+        ..ImpactParams::default()
+    };
+    let mut s = Sample::new(params, 3).unwrap();
+    s.run_next().unwrap();
+    let ckpt = dir.path().join("worn.ckpt");
+    std::fs::write(&ckpt, s.checkpoint()).unwrap();
+    let stdout = ok(&grit(&[
+        "study",
+        "settle",
+        "--resume",
+        ckpt.to_str().unwrap(),
+        "--impacts",
+        "2",
+        "--other-fraction",
+        "0.2",
+        "--threads",
+        "1",
+        "--json",
+    ]));
+    let rows: Vec<SettleRow> = serde_json::from_str(&stdout).unwrap();
+    s.run_next().unwrap();
+    s.run_next().unwrap();
+    let own = &s.records()[1..];
+    assert_eq!(rows.len(), 2);
+    for (row, rec) in rows.iter().zip(own) {
+        assert_eq!(row.impact, rec.impact);
+        assert_eq!(row.mass_loss_kg.to_bits(), rec.mass_loss_kg.to_bits());
+        assert_eq!(row.steps, rec.outcome.steps);
+        assert!(row.steps_other <= row.steps && row.sim_time_other_s <= row.sim_time_s);
+    }
+    assert!(
+        rows.iter().any(|r| r.steps_other < r.steps),
+        "a five times looser end shortened no impact: {rows:?}"
+    );
+}
+
 #[test]
 fn studies_refuse_bad_input_naming_the_option() {
     let dir = tempfile::tempdir().unwrap();
@@ -196,8 +242,8 @@ fn studies_refuse_bad_input_naming_the_option() {
             "--ppd: give resolutions of 6 to 128",
         ),
         (
-            &["study", "settle", "--angle", "45", "--strict-fraction", "0.5"],
-            "--strict-fraction: must be > 0 and below the scene's settle_fraction 0.02",
+            &["study", "settle", "--angle", "45", "--other-fraction", "0.02"],
+            "--other-fraction: must be > 0, below 1 and not the scene's settle_fraction 0.02",
         ),
         (&["study", "budget"], "angle: required"),
         (

@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use grit_erosion::studies::settle::{settle_study, SettleRow};
+use grit_erosion::Sample;
 use grit_sph::coupling::DEFAULT_SWITCH_POROSITY;
 use grit_sph::verification::jet_grain::{self, GrainRide, RcScene, BEFORE_CONTACT_D, GRAIN_D};
 
@@ -105,23 +106,29 @@ enum Study {
         #[arg(long)]
         json: bool,
     },
-    /// Runs a sample and each of its impacts again, from the same surface, with a stricter end
-    /// criterion: mass loss and damage must not depend on when an impact ends.
+    /// Runs a sample and each of its impacts again, from the same surface, with another end
+    /// criterion: a stricter one shows whether mass loss and damage depend on when an impact
+    /// ends, a looser one what it would save and change (docs/erosion.md).
     #[command(
-        after_help = "Example: grit study settle --angle 45 --impacts 20 --strict-fraction 0.002"
+        after_help = "Example: grit study settle --angle 45 --impacts 20 --other-fraction 0.002\n         grit study settle --resume job.ckpt --impacts 20 --other-fraction 0.1"
     )]
     Settle {
         #[command(flatten)]
         scene: SceneArgs,
-        /// Number of impacts.
+        /// Start from this checkpoint (a job's worn surface, as `grit sample --resume` takes it)
+        /// with its own scene and seed, instead of a fresh surface.
+        #[arg(long)]
+        resume: Option<std::path::PathBuf>,
+        /// Number of impacts to run (from the checkpoint, with --resume).
         #[arg(long, default_value_t = 20, value_parser = crate::cli::impact_count)]
         impacts: u32,
-        /// Seed of the sample.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// The stricter settle fraction.
+        /// Seed of the fresh sample.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// The other settle fraction each impact is run again with: below the scene's for a
+        /// stricter end, above it for a looser one.
         #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
-        strict_fraction: f64,
+        other_fraction: f64,
         /// Worker threads of the engine (default: all cores).
         #[arg(long, value_parser = crate::cli::thread_count)]
         threads: Option<usize>,
@@ -267,50 +274,62 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
         }
         Study::Settle {
             scene,
+            resume,
             impacts,
             seed,
-            strict_fraction,
+            other_fraction,
             threads,
             json,
         } => {
-            let p = scene.params()?;
-            if !(strict_fraction > 0.0 && strict_fraction < p.settle_fraction) {
+            let s = match &resume {
+                Some(path) => {
+                    let flag = scene.first_given().or(seed.is_some().then_some("--seed"));
+                    if let Some(flag) = flag {
+                        bail!("{flag}: --resume runs the scene and seed stored in the checkpoint; leave the scene flags out");
+                    }
+                    read_checkpoint(path)?
+                }
+                None => Sample::new(scene.params()?, seed.unwrap_or(1))?,
+            };
+            let own = s.params().settle_fraction;
+            if !(other_fraction > 0.0 && other_fraction < 1.0 && other_fraction != own) {
                 bail!(
-                    "--strict-fraction: must be > 0 and below the scene's settle_fraction {}, got {strict_fraction}",
-                    p.settle_fraction
+                    "--other-fraction: must be > 0, below 1 and not the scene's settle_fraction {own}, got {other_fraction}"
                 );
             }
+            let start = s.impacts_done();
             let bar = progress::bar(impacts as u64, "impacts", true);
             let rows = pool(threads)?
-                .install(|| settle_study(&p, seed, impacts, strict_fraction, |_| bar.inc(1)))?;
+                .install(|| settle_study(s, impacts, other_fraction, |_| bar.inc(1)))?;
             bar.finish();
             if json {
                 say!("{}", serde_json::to_string_pretty(&rows)?);
                 return Ok(ExitCode::SUCCESS);
             }
-            say!(
-                "settle_fraction {} against {strict_fraction}",
-                p.settle_fraction
-            );
-            say!("impact  loss_kg_m   loss_strict  dD        dD_strict  t_s        t_strict_s");
+            say!("settle_fraction {own} against {other_fraction}, from impact {start}");
+            say!("impact  loss_kg_m   loss_other   dD        dD_other   t_s        t_other_s  steps  steps_other");
             for r in &rows {
                 say!(
-                    "{:>6}  {:>10.3e}  {:>10.3e}  {:>8.4}  {:>8.4}  {:>9.3e}  {:>9.3e}",
+                    "{:>6}  {:>10.3e}  {:>10.3e}  {:>8.4}  {:>8.4}  {:>9.3e}  {:>9.3e}  {:>5}  {:>11}",
                     r.impact,
                     r.mass_loss_kg,
-                    r.mass_loss_strict_kg,
+                    r.mass_loss_other_kg,
                     r.damage_added,
-                    r.damage_added_strict,
+                    r.damage_added_other,
                     r.sim_time_s,
-                    r.sim_time_strict_s
+                    r.sim_time_other_s,
+                    r.steps,
+                    r.steps_other
                 );
             }
             let sum = |f: fn(&SettleRow) -> f64| -> f64 { rows.iter().map(f).sum() };
-            let (d, ds) = (sum(|r| r.damage_added), sum(|r| r.damage_added_strict));
-            let (m, ms) = (sum(|r| r.mass_loss_kg), sum(|r| r.mass_loss_strict_kg));
+            let (d, ds) = (sum(|r| r.damage_added), sum(|r| r.damage_added_other));
+            let (m, ms) = (sum(|r| r.mass_loss_kg), sum(|r| r.mass_loss_other_kg));
+            let (n, ns) = (sum(|r| r.steps as f64), sum(|r| r.steps_other as f64));
             say!(
-                "total damage added {d:.4} vs {ds:.4} ({:+.2}%), mass loss {m:.3e} vs {ms:.3e} kg/m",
-                100.0 * (ds - d) / d.max(f64::MIN_POSITIVE)
+                "total damage added {d:.4} vs {ds:.4} ({:+.2}%), mass loss {m:.3e} vs {ms:.3e} kg/m, steps {n} vs {ns} ({:.2}x)",
+                100.0 * (ds - d) / d.max(f64::MIN_POSITIVE),
+                ns / n.max(1.0)
             );
             Ok(ExitCode::SUCCESS)
         }
