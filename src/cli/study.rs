@@ -4,12 +4,11 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use grit_erosion::studies::settle::{settle_study, SettleRow};
-use grit_erosion::Sample;
 use grit_sph::coupling::DEFAULT_SWITCH_POROSITY;
 use grit_sph::verification::jet_grain::{self, GrainRide, RcScene, BEFORE_CONTACT_D, GRAIN_D};
 
 use super::output::{check_writable, say};
-use super::sample::{read_checkpoint, SceneArgs};
+use super::sample::{read_checkpoint, start_sample, SceneArgs};
 use super::{pool, progress};
 
 /// Arguments of `grit study`.
@@ -281,16 +280,7 @@ pub fn study(a: StudyArgs) -> anyhow::Result<ExitCode> {
             threads,
             json,
         } => {
-            let s = match &resume {
-                Some(path) => {
-                    let flag = scene.first_given().or(seed.is_some().then_some("--seed"));
-                    if let Some(flag) = flag {
-                        bail!("{flag}: --resume runs the scene and seed stored in the checkpoint; leave the scene flags out");
-                    }
-                    read_checkpoint(path)?
-                }
-                None => Sample::new(scene.params()?, seed.unwrap_or(1))?,
-            };
+            let s = start_sample(resume.as_deref(), &scene, seed)?;
             let own = s.params().settle_fraction;
             if !(other_fraction > 0.0 && other_fraction < 1.0 && other_fraction != own) {
                 bail!(

@@ -85,21 +85,32 @@ pub fn read_checkpoint(path: &std::path::Path) -> anyhow::Result<Sample> {
     Sample::from_checkpoint(&bytes).with_context(|| format!("{}", path.display()))
 }
 
+/// The sample a command starts from: the checkpoint `resume` names, with its own scene and seed
+/// (scene flags or `--seed` beside it are refused), or a fresh one of the scene flags and `seed`
+/// (default 1).
+pub fn start_sample(
+    resume: Option<&std::path::Path>,
+    scene: &SceneArgs,
+    seed: Option<u64>,
+) -> anyhow::Result<Sample> {
+    match resume {
+        Some(path) => {
+            let seed = seed.is_some().then_some("--seed");
+            if let Some(flag) = scene.first_given().or(seed) {
+                bail!("{flag}: --resume runs the scene and seed stored in the checkpoint; leave the scene flags out");
+            }
+            read_checkpoint(path)
+        }
+        None => Ok(Sample::new(scene.params()?, seed.unwrap_or(1))?),
+    }
+}
+
 /// Runs one sample locally with a progress bar and prints its mass-loss series.
 pub fn sample(a: SampleArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &a.result.out {
         check_writable("--out", path)?;
     }
-    let mut s = match &a.resume {
-        Some(path) => {
-            let seed = a.seed.is_some().then_some("--seed");
-            if let Some(flag) = a.scene.first_given().or(seed) {
-                bail!("{flag}: --resume runs the scene and seed stored in the checkpoint; leave the scene flags out");
-            }
-            read_checkpoint(path)?
-        }
-        None => Sample::new(a.scene.params()?, a.seed.unwrap_or(1))?,
-    };
+    let mut s = start_sample(a.resume.as_deref(), &a.scene, a.seed)?;
     let p = s.params().clone();
     let seed = s.seed();
     if s.impacts_done() >= a.impacts {
